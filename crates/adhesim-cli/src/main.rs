@@ -1,0 +1,235 @@
+//! `adhesim`: command-line front end. Parses arguments, shows progress, maps outcomes to
+//! exit codes (0 success, 1 the run stopped early, 2 invalid input or unwritable output).
+
+use adhesim::run::{Outcome, Progress};
+use adhesim::time::StepReport;
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+/// Finite-element dynamics of soft bodies in frictional contact with recoverable adhesion.
+///
+/// A scenario file (TOML, SI units) describes bodies, materials, prescribed motions and time
+/// stepping; see docs/scenario.md. Outputs: ParaView frames (<name>.pvd + vtu/), history.csv
+/// (one row per step) and run.json (what ran and how it ended).
+#[derive(Parser)]
+#[command(name = "adhesim", version, about, long_about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a scenario and write its outputs.
+    ///
+    /// Exit codes: 0 the run reached its end time, 1 it stopped early (Δt fell below its
+    /// minimum; everything computed until then is kept), 2 the scenario is invalid or the
+    /// outputs cannot be written.
+    Run {
+        /// Scenario file (TOML).
+        scenario: PathBuf,
+        /// Output directory [default: out/<scenario name>].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Print nothing but errors.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Validate a scenario without running it: parse, check every value, build the meshes
+    /// and check them for inverted elements. Exit code 0 when valid, 2 otherwise.
+    Check {
+        /// Scenario file (TOML).
+        scenario: PathBuf,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Run {
+            scenario,
+            out,
+            quiet,
+        } => run(&scenario, out, quiet),
+        Command::Check { scenario } => check(&scenario),
+    }
+}
+
+fn fail_input(msg: impl std::fmt::Display) -> ExitCode {
+    eprintln!("error: {msg}");
+    ExitCode::from(2)
+}
+
+fn check(path: &Path) -> ExitCode {
+    let problem = match adhesim::scenario::load(path) {
+        Ok(p) => p,
+        Err(e) => return fail_input(e),
+    };
+    let bodies: Vec<_> = problem
+        .bodies
+        .iter()
+        .map(|b| (&b.mesh, b.material.clone()))
+        .collect();
+    if let Err(bad) = adhesim::assembly::Discretisation::new(&bodies) {
+        let err = adhesim::time::SetupError::BadElements(bad);
+        return fail_input(format!("{}: {err}", path.display()));
+    }
+    let nodes: usize = problem.bodies.iter().map(|b| b.mesh.num_nodes()).sum();
+    let cells: usize = problem.bodies.iter().map(|b| b.mesh.num_cells()).sum();
+    println!(
+        "{}: valid — {} bod{}, {nodes} nodes, {cells} cells, t_end = {} s, dt = {} s",
+        path.display(),
+        problem.bodies.len(),
+        if problem.bodies.len() == 1 {
+            "y"
+        } else {
+            "ies"
+        },
+        problem.time.t_end,
+        problem.time.dt
+    );
+    ExitCode::SUCCESS
+}
+
+fn run(path: &Path, out: Option<PathBuf>, quiet: bool) -> ExitCode {
+    let problem = match adhesim::scenario::load(path) {
+        Ok(p) => p,
+        Err(e) => return fail_input(e),
+    };
+    let out = out.unwrap_or_else(|| PathBuf::from("out").join(&problem.name));
+    let mut progress: Box<dyn Progress> = if quiet {
+        Box::new(adhesim::run::Silent)
+    } else if std::io::stderr().is_terminal() {
+        Box::new(Bar::new())
+    } else {
+        Box::new(Lines::new())
+    };
+    if !quiet {
+        eprintln!("running {} → {}", path.display(), out.display());
+    }
+    let summary = match adhesim::run::run(problem, Some(path), &out, progress.as_mut()) {
+        Ok(s) => s,
+        Err(e) => return fail_input(format!("{}: {e}", path.display())),
+    };
+    drop(progress);
+    match &summary.outcome {
+        Outcome::Finished => {
+            if !quiet {
+                eprintln!(
+                    "done: {} steps ({} cut-backs, {} Newton iterations) in {:.1} s; {} frames in {}",
+                    summary.steps,
+                    summary.cutbacks,
+                    summary.newton_iterations,
+                    summary.wall_time,
+                    summary.frames,
+                    out.display()
+                );
+            }
+            ExitCode::SUCCESS
+        }
+        Outcome::Failed(msg) => {
+            eprintln!(
+                "error: the run stopped at t = {:.6e} s of {} s: {msg}\nEvery output written until then is intact in {}.",
+                summary.t_reached,
+                summary.t_end,
+                out.display()
+            );
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// A progress bar for terminals.
+struct Bar {
+    bar: ProgressBar,
+}
+
+impl Bar {
+    fn new() -> Self {
+        let bar = ProgressBar::new(1000);
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{bar:30} {percent:>3}% {msg} [{elapsed_precise}, ETA {eta}]",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        Bar { bar }
+    }
+}
+
+impl Progress for Bar {
+    fn step(&mut self, r: &StepReport, t_end: f64) {
+        self.bar.set_position((1000.0 * r.t / t_end).round() as u64);
+        self.bar.set_message(format!(
+            "step {} t = {:.4e} s Δt = {:.2e} s Newton {}{}",
+            r.step,
+            r.t,
+            r.dt,
+            r.newton_iterations,
+            if r.cutbacks > 0 {
+                format!(" ({} cut-backs)", r.cutbacks)
+            } else {
+                String::new()
+            }
+        ));
+    }
+    fn message(&mut self, text: &str) {
+        self.bar.println(text);
+    }
+}
+
+impl Drop for Bar {
+    fn drop(&mut self) {
+        self.bar.finish_and_clear();
+    }
+}
+
+/// Plain progress lines (at most one every two seconds) for logs and pipes.
+struct Lines {
+    start: Instant,
+    last: Instant,
+}
+
+impl Lines {
+    fn new() -> Self {
+        let now = Instant::now();
+        Lines {
+            start: now,
+            last: now - Duration::from_secs(10),
+        }
+    }
+}
+
+impl Progress for Lines {
+    fn step(&mut self, r: &StepReport, t_end: f64) {
+        let done = r.t >= t_end * (1.0 - 1e-12);
+        if self.last.elapsed() < Duration::from_secs(2) && !done {
+            return;
+        }
+        self.last = Instant::now();
+        let frac = (r.t / t_end).clamp(0.0, 1.0);
+        let elapsed = self.start.elapsed().as_secs_f64();
+        let eta = if frac > 0.0 {
+            elapsed * (1.0 - frac) / frac
+        } else {
+            0.0
+        };
+        eprintln!(
+            "step {:>6}  t = {:.4e} s ({:5.1}%)  Δt = {:.2e} s  Newton {:>2}  cut-backs {}  ETA {:.0} s",
+            r.step,
+            r.t,
+            100.0 * frac,
+            r.dt,
+            r.newton_iterations,
+            r.cutbacks,
+            eta
+        );
+    }
+    fn message(&mut self, text: &str) {
+        eprintln!("{text}");
+    }
+}

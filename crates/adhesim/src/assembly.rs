@@ -1,0 +1,377 @@
+//! Global assembly over all bodies: one node numbering (bodies one after another), the
+//! sparsity pattern built once, element colouring so that the scatter runs in parallel
+//! without locks, and the constant mass matrix.
+
+use crate::element::{
+    consistent_mass, element_response, hex8_geometry, tet4_geometry, DegenerateElement, GaussPoint,
+};
+use crate::linalg::BlockPattern;
+use crate::material::Hyperelastic;
+use crate::mesh::Mesh;
+use rayon::prelude::*;
+use std::sync::Arc;
+
+/// Elements of one kind (N nodes, G Gauss points) with their reference data.
+pub struct ElementBlock<const N: usize, const G: usize> {
+    /// Global node indices.
+    pub nodes: Vec<[usize; N]>,
+    /// Reference Gauss-point data.
+    pub gauss: Vec<[GaussPoint<N>; G]>,
+    /// Index of the owning body.
+    pub body: Vec<usize>,
+    /// For local pair (a, b): rank of min(node a, node b) among the upper neighbours of
+    /// max(node a, node b) in the pattern.
+    ranks: Vec<[[u32; N]; N]>,
+    /// Element indices grouped so that no two elements of a group share a node.
+    colours: Vec<Vec<usize>>,
+}
+
+impl<const N: usize, const G: usize> ElementBlock<N, G> {
+    fn empty() -> Self {
+        ElementBlock {
+            nodes: vec![],
+            gauss: vec![],
+            body: vec![],
+            ranks: vec![],
+            colours: vec![],
+        }
+    }
+    /// Number of elements.
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+    /// True when there are no elements of this kind.
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+}
+
+/// An element whose reference geometry is degenerate or inverted.
+#[derive(Debug, Clone)]
+pub struct BadElement {
+    /// Body index.
+    pub body: usize,
+    /// Cell index within the body's mesh (hexes first, then tets).
+    pub cell: usize,
+    /// The offending reference Jacobian determinant.
+    pub det: f64,
+}
+
+/// The discretised bodies: what is needed to assemble forces and tangents.
+pub struct Discretisation {
+    /// First global node index of each body.
+    pub node_offset: Vec<usize>,
+    /// Total number of nodes.
+    pub num_nodes: usize,
+    /// Reference coordinates of all nodes [m].
+    pub reference: Vec<[f64; 3]>,
+    /// Material of each body.
+    pub materials: Vec<Arc<dyn Hyperelastic>>,
+    /// Hexahedra.
+    pub hexes: ElementBlock<8, 8>,
+    /// Tetrahedra.
+    pub tets: ElementBlock<4, 1>,
+    /// Upper-triangle block pattern of every system matrix.
+    pub pattern: BlockPattern,
+}
+
+/// Assembled internal force, tangent values (pattern order), energy and min J.
+pub struct Assembled {
+    /// Internal force vector [N], 3 per node.
+    pub force: Vec<f64>,
+    /// Tangent stiffness values in pattern order [N/m] (empty if not requested).
+    pub tangent: Vec<f64>,
+    /// Total strain energy [J].
+    pub energy: f64,
+    /// Smallest det F over all Gauss points.
+    pub min_j: f64,
+}
+
+struct SyncPtr(*mut f64);
+unsafe impl Sync for SyncPtr {}
+unsafe impl Send for SyncPtr {}
+impl SyncPtr {
+    /// # Safety
+    /// No two threads may write the same index concurrently.
+    #[inline]
+    unsafe fn add(&self, i: usize, v: f64) {
+        *self.0.add(i) += v;
+    }
+}
+
+fn colour_elements<const N: usize>(nodes: &[[usize; N]], num_nodes: usize) -> Vec<Vec<usize>> {
+    // Greedy colouring: an element takes the first colour none of its nodes has seen.
+    let mut node_colours: Vec<u64> = vec![0; num_nodes];
+    let mut colours: Vec<Vec<usize>> = Vec::new();
+    let mut overflow: Vec<usize> = Vec::new();
+    for (e, en) in nodes.iter().enumerate() {
+        let used = en.iter().fold(0u64, |m, &n| m | node_colours[n]);
+        let c = (!used).trailing_zeros() as usize;
+        if c >= 64 {
+            overflow.push(e);
+            continue;
+        }
+        if c >= colours.len() {
+            colours.resize(c + 1, Vec::new());
+        }
+        colours[c].push(e);
+        for &n in en {
+            node_colours[n] |= 1 << c;
+        }
+    }
+    // Pathological meshes with more than 64 colours: one element per group.
+    colours.extend(overflow.into_iter().map(|e| vec![e]));
+    colours
+}
+
+fn fill_ranks<const N: usize, const G: usize>(
+    block: &mut ElementBlock<N, G>,
+    pattern: &BlockPattern,
+) {
+    block.ranks = block
+        .nodes
+        .iter()
+        .map(|en| {
+            let mut r = [[0u32; N]; N];
+            for a in 0..N {
+                for b in 0..N {
+                    let (lo, hi) = if en[a] <= en[b] {
+                        (en[a], en[b])
+                    } else {
+                        (en[b], en[a])
+                    };
+                    r[a][b] = pattern
+                        .rank(lo, hi)
+                        .expect("pattern holds every element pair")
+                        as u32;
+                }
+            }
+            r
+        })
+        .collect();
+    block.colours = colour_elements(&block.nodes, pattern.num_nodes);
+}
+
+impl Discretisation {
+    /// Builds the discretisation of the given bodies (mesh, material). Fails with the list
+    /// of degenerate or inverted reference elements.
+    pub fn new(bodies: &[(&Mesh, Arc<dyn Hyperelastic>)]) -> Result<Self, Vec<BadElement>> {
+        let mut node_offset = Vec::new();
+        let mut reference = Vec::new();
+        let mut hexes = ElementBlock::<8, 8>::empty();
+        let mut tets = ElementBlock::<4, 1>::empty();
+        let mut bad = Vec::new();
+        for (bi, (mesh, _)) in bodies.iter().enumerate() {
+            let off = reference.len();
+            node_offset.push(off);
+            reference.extend_from_slice(&mesh.nodes);
+            for (ci, h) in mesh.hexes.iter().enumerate() {
+                let x = h.map(|n| mesh.nodes[n]);
+                match hex8_geometry(&x) {
+                    Ok(g) => {
+                        hexes.nodes.push(h.map(|n| n + off));
+                        hexes.gauss.push(g);
+                        hexes.body.push(bi);
+                    }
+                    Err(DegenerateElement { det }) => bad.push(BadElement {
+                        body: bi,
+                        cell: ci,
+                        det,
+                    }),
+                }
+            }
+            for (ci, t) in mesh.tets.iter().enumerate() {
+                let x = t.map(|n| mesh.nodes[n]);
+                match tet4_geometry(&x) {
+                    Ok(g) => {
+                        tets.nodes.push(t.map(|n| n + off));
+                        tets.gauss.push(g);
+                        tets.body.push(bi);
+                    }
+                    Err(DegenerateElement { det }) => bad.push(BadElement {
+                        body: bi,
+                        cell: mesh.hexes.len() + ci,
+                        det,
+                    }),
+                }
+            }
+        }
+        if !bad.is_empty() {
+            return Err(bad);
+        }
+        let num_nodes = reference.len();
+        let pattern = BlockPattern::from_cells(
+            num_nodes,
+            hexes
+                .nodes
+                .iter()
+                .map(|c| &c[..])
+                .chain(tets.nodes.iter().map(|c| &c[..])),
+        );
+        fill_ranks(&mut hexes, &pattern);
+        fill_ranks(&mut tets, &pattern);
+        let materials = bodies.iter().map(|(_, m)| m.clone()).collect();
+        Ok(Discretisation {
+            node_offset,
+            num_nodes,
+            reference,
+            materials,
+            hexes,
+            tets,
+            pattern,
+        })
+    }
+
+    /// Number of scalar unknowns (3 per node).
+    pub fn num_dofs(&self) -> usize {
+        3 * self.num_nodes
+    }
+
+    /// Internal force, and the tangent when `with_tangent`, at global displacement `u`.
+    pub fn assemble(&self, u: &[f64], with_tangent: bool) -> Assembled {
+        let mut out = Assembled {
+            force: vec![0.0; self.num_dofs()],
+            tangent: if with_tangent {
+                vec![0.0; self.pattern.nnz()]
+            } else {
+                Vec::new()
+            },
+            energy: 0.0,
+            min_j: f64::INFINITY,
+        };
+        let (e1, j1) = self.assemble_block(&self.hexes, u, &mut out, with_tangent);
+        let (e2, j2) = self.assemble_block(&self.tets, u, &mut out, with_tangent);
+        out.energy = e1 + e2;
+        out.min_j = j1.min(j2);
+        out
+    }
+
+    fn assemble_block<const N: usize, const G: usize>(
+        &self,
+        block: &ElementBlock<N, G>,
+        u: &[f64],
+        out: &mut Assembled,
+        with_tangent: bool,
+    ) -> (f64, f64) {
+        let fptr = SyncPtr(out.force.as_mut_ptr());
+        let kptr = SyncPtr(out.tangent.as_mut_ptr());
+        let pattern = &self.pattern;
+        let mut energy = 0.0;
+        let mut min_j = f64::INFINITY;
+        for colour in &block.colours {
+            let (e, j) = colour
+                .par_iter()
+                .with_min_len(64)
+                .map(|&e| {
+                    let en = &block.nodes[e];
+                    let ue: [[f64; 3]; N] = std::array::from_fn(|a| {
+                        let n = en[a];
+                        [u[3 * n], u[3 * n + 1], u[3 * n + 2]]
+                    });
+                    let mat = &*self.materials[block.body[e]];
+                    let r = element_response(&block.gauss[e], &ue, mat, with_tangent);
+                    // SAFETY: elements of one colour share no node, so they write disjoint
+                    // entries of the force vector and of the tangent values.
+                    unsafe {
+                        for a in 0..N {
+                            for i in 0..3 {
+                                fptr.add(3 * en[a] + i, r.force[a][i]);
+                            }
+                        }
+                        if let Some(kt) = &r.tangent {
+                            let ranks = &block.ranks[e];
+                            for a in 0..N {
+                                for b in 0..N {
+                                    let (na, nb) = (en[a], en[b]);
+                                    if na > nb {
+                                        continue;
+                                    }
+                                    let kab = &kt[a][b];
+                                    let rank = ranks[a][b] as usize;
+                                    for k in 0..3 {
+                                        let base = pattern.col_ptr[3 * nb + k] + 3 * rank;
+                                        let imax = if na == nb { k + 1 } else { 3 };
+                                        for i in 0..imax {
+                                            kptr.add(base + i, kab[(i, k)]);
+                                        }
+                                    }
+                                }
+                            }
+                        }
+                    }
+                    (r.energy, r.min_j)
+                })
+                .reduce(|| (0.0, f64::INFINITY), |a, b| (a.0 + b.0, a.1.min(b.1)));
+            energy += e;
+            min_j = min_j.min(j);
+        }
+        (energy, min_j)
+    }
+
+    /// Mass matrix values in pattern order [kg], consistent or row-sum lumped, from the
+    /// density [kg/m³] of each body.
+    pub fn mass(&self, density: &[f64], lumped: bool) -> Vec<f64> {
+        let mut m = vec![0.0; self.pattern.nnz()];
+        self.mass_block(&self.hexes, density, lumped, &mut m);
+        self.mass_block(&self.tets, density, lumped, &mut m);
+        m
+    }
+
+    fn mass_block<const N: usize, const G: usize>(
+        &self,
+        block: &ElementBlock<N, G>,
+        density: &[f64],
+        lumped: bool,
+        m: &mut [f64],
+    ) {
+        for e in 0..block.len() {
+            let me = consistent_mass(&block.gauss[e], density[block.body[e]]);
+            let en = &block.nodes[e];
+            for a in 0..N {
+                for b in 0..N {
+                    let (na, nb) = (en[a], en[b]);
+                    if lumped {
+                        if a == b {
+                            continue;
+                        }
+                        let r = block.ranks[e][a][a] as usize;
+                        for k in 0..3 {
+                            m[self.pattern.position(r, na, k, k)] += me[a][b];
+                        }
+                        continue;
+                    }
+                    if na > nb {
+                        continue;
+                    }
+                    let r = block.ranks[e][a][b] as usize;
+                    for k in 0..3 {
+                        m[self.pattern.position(r, nb, k, k)] += me[a][b];
+                    }
+                }
+                if lumped {
+                    let r = block.ranks[e][a][a] as usize;
+                    for k in 0..3 {
+                        m[self.pattern.position(r, en[a], k, k)] += me[a][a];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Reference volume of all elements [m³].
+    pub fn volume(&self) -> f64 {
+        let v1: f64 = self
+            .hexes
+            .gauss
+            .iter()
+            .flat_map(|g| g.iter().map(|p| p.weight))
+            .sum();
+        let v2: f64 = self
+            .tets
+            .gauss
+            .iter()
+            .flat_map(|g| g.iter().map(|p| p.weight))
+            .sum();
+        v1 + v2
+    }
+}

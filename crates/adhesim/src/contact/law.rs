@@ -1,0 +1,1716 @@
+//! The local interface law at one contact point (model.md §5–§6): dry Signorini–Coulomb contact
+//! through the bi-potential projection, Raous–Cangémi–Cocou (RCC) recoverable adhesion, and the
+//! point solver used inside the nonlinear Gauss–Seidel sweep over contact points.
+//!
+//! Everything here is a pure function on plain arrays: no mesh, no allocation.
+//!
+//! # Conventions
+//! - Local frame components are ordered (t1, t2, n).
+//! - `r` is the force on the slave node [N]; `r_n > 0` is compression. `r = r̄ + r̃` (dry part plus
+//!   adhesive part).
+//! - `x = (x_t1, x_t2, x_n)` [m]: `x_n` is the gap at the end of the step (≥ 0 apart), `x_t` the
+//!   slip increment over the step.
+//! - Interface parameters are per unit area; nodal forces are traction × tributary area `A` [m²].
+//!
+//! # Choices documented here
+//! - **ε cut-off.** `β < ε` means a broken bond (`β = 0`) unless the bond is *forming*, i.e. the
+//!   equilibrium `β∞ = min(1, w/E)` for the current stretch energy `E` is itself `≥ ε`. A plain
+//!   `β < ε → 0` would forbid bonding whenever `Δt·w/b < ε`, so bonding would vanish as `Δt → 0`.
+//!   The implicit Euler `β₁` is a convex combination of `β₀` and `β∞` (before the clamp at 1), so a
+//!   decaying bond below ε always has `β∞ < ε` and is cut exactly as the paper intends.
+//! - **Bonds at a distance.** [`beta_update`] follows the RCC law for any gap: from `β₀ = 0` at a
+//!   gap `x` a bond forms when `w/(C_n x²) ≥ ε`, i.e. `x ≤ √(w/(ε C_n)) = 100 x_c` for ε = 1e-4
+//!   (`x_c = √(w/C_n)`). Its traction there is at most `w²/(C_n x³)`. Candidates beyond the
+//!   detection distance are the caller's business: they carry `β = 0` (model.md §5).
+//! - **Sign of the sliding projection.** The paper's eq 32 prints `+ μ n`; with `r_n > 0` as
+//!   compression that leaves the cone, so `− μ n` is used, as model.md says.
+
+use std::f64::consts::PI;
+
+/// Default bond cut-off ε of the RCC law: below it a bond is broken.
+pub const DEFAULT_BETA_EPS: f64 = 1e-4;
+
+/// Largest number of Newton steps of the adhesive sub-problem per evaluation.
+const MAX_INNER: usize = 60;
+/// Largest number of step lengths tried along a Newton direction of the dry force.
+const NEWTON_HALVINGS: usize = 4;
+/// Largest number of step halvings in a line search.
+const MAX_HALVINGS: usize = 40;
+
+type V3 = [f64; 3];
+type M3 = [[f64; 3]; 3];
+
+/// RCC adhesion parameters of a contact pair, per unit area.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RccParams {
+    /// Decohesion energy w [J/m²].
+    pub w: f64,
+    /// Normal adhesive stiffness C_n [N/m³].
+    pub cn: f64,
+    /// Tangential adhesive stiffness C_t [N/m³].
+    pub ct: f64,
+    /// Interface viscosity b [N·s/m = J·s/m²]; `b = 0` is the rate-independent limit.
+    pub b: f64,
+    /// Cut-off ε of the intensity of adhesion β [-] (default [`DEFAULT_BETA_EPS`]).
+    pub eps: f64,
+}
+
+impl RccParams {
+    /// Parameters with the default cut-off ε = [`DEFAULT_BETA_EPS`].
+    pub fn new(w: f64, cn: f64, ct: f64, b: f64) -> Self {
+        Self {
+            w,
+            cn,
+            ct,
+            b,
+            eps: DEFAULT_BETA_EPS,
+        }
+    }
+
+    /// Critical opening x_c = √(w/C_n) [m] where the quasi-static normal traction peaks.
+    pub fn critical_opening(&self) -> f64 {
+        if self.cn > 0.0 {
+            (self.w.max(0.0) / self.cn).sqrt()
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// Largest quasi-static adhesive traction √(max(C_n, C_t)·w) [Pa].
+    pub fn peak_traction(&self) -> f64 {
+        (self.cn.max(self.ct).max(0.0) * self.w.max(0.0)).sqrt()
+    }
+}
+
+/// Interface law of a contact pair.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InterfaceLaw {
+    /// Coulomb friction coefficient μ ≥ 0 [-] (negative values are treated as 0).
+    pub mu: f64,
+    /// RCC adhesion, or `None` for dry contact.
+    pub adhesion: Option<RccParams>,
+}
+
+/// Which case of the bi-potential projection the dry part fell into. Whether the point is
+/// bonded is reported separately (β > 0).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContactState {
+    /// Separating: r̄ = 0 (the gap is open).
+    Apart,
+    /// Sticking: r̄ inside the Coulomb cone, no slip.
+    Stick,
+    /// Sliding: r̄ on the boundary of the cone, opposing the slip.
+    Slide,
+}
+
+/// The committed interface state of a slave node at the start of a step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BondState {
+    /// Intensity of adhesion β₀ ∈ [0, 1] [-].
+    pub beta: f64,
+    /// Accumulated stretch of the adhesive links in the (t1, t2) plane [m].
+    pub ut: [f64; 2],
+}
+
+/// Projection of `r_star` [N] onto the Coulomb cone K_μ = {r_n ≥ 0, ‖r_t‖ ≤ μ r_n}
+/// (model.md §5), with the case it fell into.
+///
+/// - separating, `μ‖r*_t‖ < −r*_n`: `r = 0`;
+/// - sticking, `‖r*_t‖ ≤ μ r*_n`: `r = r*`;
+/// - sliding otherwise: `r_n = (r*_n + μ‖r*_t‖)/(1 + μ²)`, `r_t = μ r_n r*_t/‖r*_t‖`.
+///
+/// `μ = 0` is frictionless contact: `r_t = 0`, `r_n = max(r*_n, 0)`.
+pub fn dry_projection(r_star: [f64; 3], mu: f64) -> ([f64; 3], ContactState) {
+    let mu = mu.max(0.0);
+    let st = norm2(r_star[0], r_star[1]);
+    let sn = r_star[2];
+    if mu * st < -sn {
+        return ([0.0; 3], ContactState::Apart);
+    }
+    if st <= mu * sn {
+        return (r_star, ContactState::Stick);
+    }
+    // Sliding: here st > μ s_n and μ st ≥ −s_n, which together give st > 0.
+    let rn = ((sn + mu * st) / (1.0 + mu * mu)).max(0.0);
+    if st > 0.0 {
+        let k = mu * rn / st;
+        ([k * r_star[0], k * r_star[1], rn], ContactState::Slide)
+    } else {
+        ([0.0, 0.0, rn], ContactState::Slide)
+    }
+}
+
+/// Bi-potential trial force r* = r̄ − ρ (x + μ‖x_t‖ n) [N] (model.md §5, paper eq 30), from the
+/// dry force `r_dry` [N], the local relative displacement `x` [m] and ρ [N/m].
+pub fn bipotential_trial(r_dry: [f64; 3], x: [f64; 3], mu: f64, rho: f64) -> [f64; 3] {
+    let mu = mu.max(0.0);
+    let xt = norm2(x[0], x[1]);
+    [
+        r_dry[0] - rho * x[0],
+        r_dry[1] - rho * x[1],
+        r_dry[2] - rho * (x[2] + mu * xt),
+    ]
+}
+
+/// Intensity of adhesion at the end of a step of `dt` [s] from `beta0`, by implicit Euler of
+/// b β̇ = w − (C_n x_n⁺² + C_t‖u_t‖²) β held in [0, 1]:
+/// β₁ = min(1, (b β₀ + Δt w)/(b + Δt E)), E = C_n x_n⁺² + C_t‖u_t‖² [J/m²·…, N/m].
+///
+/// - `xn` [m] is the gap (only its positive part stretches the links), `ut` [m] the accumulated
+///   bond stretch including this step's slip.
+/// - `b = 0` (or negative): rate-independent β₁ = min(1, w/E), 1 when E = 0 and w > 0.
+/// - `dt ≤ 0` with `b > 0`: no time elapses, β₁ = β₀.
+/// - Cut-off: β₁ < ε gives 0 unless the bond is forming (β∞ = min(1, w/E) ≥ ε); see the module
+///   documentation. With β₀ = 0 at a gap x the bond forms only if w/(C_n x²) ≥ ε.
+pub fn beta_update(beta0: f64, dt: f64, p: &RccParams, xn: f64, ut: [f64; 2]) -> f64 {
+    beta_step(beta0, dt, p, stretch_energy(p, xn, ut)).0
+}
+
+/// Adhesive force r̃ = (−C_t u_t1 β² A, −C_t u_t2 β² A, −C_n x_n⁺ β² A) [N] for the intensity of
+/// adhesion `beta`, gap `xn` [m], bond stretch `ut` [m] and tributary area `area` [m²].
+pub fn adhesive_force(beta: f64, p: &RccParams, xn: f64, ut: [f64; 2], area: f64) -> [f64; 3] {
+    let k = beta * beta * area;
+    [
+        -p.ct * ut[0] * k,
+        -p.ct * ut[1] * k,
+        -p.cn * xn.max(0.0) * k,
+    ]
+}
+
+/// ρ [N/m] for the bi-potential iteration at a point with Delassus block `w_aa` [m/N]:
+/// 1/λ_max of its symmetric part. The fixed point r̄ ← Proj(r̄ − ρ(x + μ‖x_t‖n)) contracts for
+/// 0 < ρ < 2/λ_max; 1/λ_max is safely inside. (1/max W_ii can reach 3/λ_max and diverge.)
+/// Falls back to 1/max|W_ii|, then 1, for degenerate blocks.
+pub fn default_rho(w_aa: [[f64; 3]; 3]) -> f64 {
+    let lmax = eig_sym3(sym(w_aa))[2];
+    if lmax.is_finite() && lmax > 0.0 {
+        return 1.0 / lmax;
+    }
+    let dmax = w_aa[0][0].abs().max(w_aa[1][1].abs()).max(w_aa[2][2].abs());
+    if dmax.is_finite() && dmax > 0.0 {
+        1.0 / dmax
+    } else {
+        1.0
+    }
+}
+
+/// The local problem at contact point α within a Gauss–Seidel sweep:
+/// x = x_free + W_αα (r̄ + r̃), with the dry and adhesive laws at the point.
+#[derive(Clone, Copy, Debug)]
+pub struct PointProblem<'a> {
+    /// Delassus diagonal block W_αα [m/N], symmetric positive definite.
+    pub w_aa: [[f64; 3]; 3],
+    /// x with the other points' current forces and this point's force removed [m].
+    pub x_free: [f64; 3],
+    /// Interface law of the pair.
+    pub law: &'a InterfaceLaw,
+    /// Committed interface state at the start of the step.
+    pub bond0: BondState,
+    /// Time step Δt [s].
+    pub dt: f64,
+    /// Tributary area A [m²].
+    pub area: f64,
+    /// Bi-potential parameter ρ [N/m], e.g. [`default_rho`].
+    pub rho: f64,
+}
+
+/// Solution of a [`PointProblem`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointSolution {
+    /// Dry part r̄ [N], in the Coulomb cone.
+    pub r_dry: [f64; 3],
+    /// Adhesive part r̃ [N].
+    pub r_adh: [f64; 3],
+    /// Local relative displacement x = x_free + W_αα (r̄ + r̃) [m].
+    pub x: [f64; 3],
+    /// Intensity of adhesion β₁ at the end of the step [-].
+    pub beta: f64,
+    /// Bond stretch to commit [m]: u_t0 + x_t while bonded (β₁ > 0), else 0.
+    pub ut: [f64; 2],
+    /// Case of the final projection of the dry part.
+    pub state: ContactState,
+    /// Outer iterations performed.
+    pub iterations: usize,
+    /// Whether the convergence criterion was met within `max_iter`.
+    pub converged: bool,
+}
+
+impl PointSolution {
+    /// Total contact force r = r̄ + r̃ [N].
+    pub fn r(&self) -> [f64; 3] {
+        add(self.r_dry, self.r_adh)
+    }
+
+    /// Whether an adhesive bond is present (β > 0).
+    pub fn bonded(&self) -> bool {
+        self.beta > 0.0
+    }
+}
+
+/// Solves the local problem at one contact point, starting from the dry-force guess `r_start`
+/// [N] (typically the point's force from the previous sweep).
+///
+/// The unknown is the dry force r̄; for each r̄ the adhesive part is solved implicitly
+/// (x = x_free + W(r̄ + r̃(x)) with β₁(x), by Newton on the incremental potential, so stiff
+/// adhesion C_n·A·‖W‖ ≫ 1 costs nothing extra). The dry part then iterates on the bi-potential
+/// fixed point r̄ = Proj(r̄ − ρ(x + μ‖x_t‖n)) with a semi-smooth Newton step on the residual
+/// F(r̄) = r̄ − Proj(…), kept when it reduces ‖F‖, and the plain fixed-point step otherwise.
+///
+/// Convergence: with r = r̄ + r̃ and the force scale
+/// s = ρ‖x_free‖ + A·√(max(C_n, C_t)·w), both the change of r over an iteration and the
+/// fixed-point defect ‖F‖ are ≤ `tol`·(‖r‖ + s). The returned r̄ is the final projection (so it
+/// lies in the cone exactly), and x, β₁, r̃ are evaluated at it.
+pub fn solve_point(
+    p: &PointProblem,
+    r_start: [f64; 3],
+    tol: f64,
+    max_iter: usize,
+) -> PointSolution {
+    solve_point_impl(p, r_start, tol, max_iter, true)
+}
+
+/// Everything derived from one value of the dry force r̄.
+#[derive(Clone, Copy, Debug)]
+struct Eval {
+    /// Dry force r̄ at which this was evaluated [N].
+    r_dry: V3,
+    /// Local relative displacement [m].
+    x: V3,
+    /// Adhesive force r̃ [N] with x = x_free + W (r̄ + r̃) exactly; equal to the law's r̃(x) to
+    /// the sub-problem's tolerance.
+    r_adh: V3,
+    /// Adhesive state at x.
+    adh: AdhEval,
+    /// Trial force r* [N].
+    r_star: V3,
+    /// Projection of r* [N].
+    proj: V3,
+    /// Case of the projection.
+    case: ContactState,
+    /// Fixed-point defect F = r̄ − Proj(r*) [N].
+    f: V3,
+}
+
+/// Adhesive law evaluated at one x.
+#[derive(Clone, Copy, Debug, Default)]
+struct AdhEval {
+    /// β₁ [-].
+    beta: f64,
+    /// Bond stretch u_t0 + x_t [m].
+    ut: [f64; 2],
+    /// Adhesive force r̃ [N].
+    force: V3,
+    /// −∂r̃/∂x [N/m] (symmetric).
+    stiff: M3,
+    /// Incremental interface potential φ(x) [J], with ∂φ/∂x = −r̃.
+    energy: f64,
+}
+
+/// Per-solve constants.
+struct Ctx<'a> {
+    p: &'a PointProblem<'a>,
+    mu: f64,
+    /// Force scale s [N] of the convergence criteria.
+    scale: f64,
+    /// Relative tolerance of the adhesive sub-problem.
+    tol_in: f64,
+}
+
+fn solve_point_impl(
+    p: &PointProblem,
+    r_start: V3,
+    tol: f64,
+    max_iter: usize,
+    newton: bool,
+) -> PointSolution {
+    let mu = p.law.mu.max(0.0);
+    let adh_scale = match &p.law.adhesion {
+        Some(a) => p.area.abs() * a.peak_traction(),
+        None => 0.0,
+    };
+    let scale = p.rho.abs() * norm(p.x_free) + adh_scale;
+    let tol = if tol.is_finite() && tol > 0.0 {
+        tol
+    } else {
+        1e-10
+    };
+    let ctx = Ctx {
+        p,
+        mu,
+        scale,
+        tol_in: (1e-3 * tol).max(1e-13),
+    };
+    let r0 = if r_start.iter().all(|v| v.is_finite()) {
+        r_start
+    } else {
+        [0.0; 3]
+    };
+    let z0 = frozen_adhesion_guess(p, add(p.x_free, matvec(p.w_aa, r0)));
+    let mut ev = evaluate(&ctx, r0, z0);
+    let mut iterations = 0;
+    let mut converged = false;
+    while iterations < max_iter {
+        iterations += 1;
+        let r_old = add(ev.r_dry, ev.r_adh);
+        let fn_old = norm(ev.f);
+        let mut next = None;
+        if newton {
+            if let Some(step) = newton_step(&ctx, &ev) {
+                let mut alpha = 1.0;
+                for _ in 0..NEWTON_HALVINGS {
+                    let trial = dry_projection(axpy(ev.r_dry, alpha, step), mu).0;
+                    let cand = evaluate(&ctx, trial, ev.r_adh);
+                    if norm(cand.f) < (1.0 - 1e-4 * alpha) * fn_old {
+                        next = Some(cand);
+                        break;
+                    }
+                    alpha *= 0.5;
+                }
+            }
+        }
+        let next_is = next.is_some();
+        ev = match next {
+            Some(cand) => cand,
+            None => evaluate(&ctx, ev.proj, ev.r_adh),
+        };
+        let r_new = add(ev.r_dry, ev.r_adh);
+        if std::env::var("LAWDBG").is_ok() {
+            eprintln!(
+                "it {iterations} newton {} rd {:?} radh {:?} x {:?} beta {} case {:?} |f| {:e}",
+                next_is,
+                ev.r_dry,
+                ev.r_adh,
+                ev.x,
+                ev.adh.beta,
+                ev.case,
+                norm(ev.f)
+            );
+        }
+        let bound = tol * (norm(r_new) + scale);
+        if norm(sub(r_new, r_old)) <= bound && norm(ev.f) <= bound {
+            converged = true;
+            break;
+        }
+    }
+    let state = ev.case;
+    let fin = evaluate(&ctx, ev.proj, ev.r_adh);
+    let ut = if fin.adh.beta > 0.0 {
+        fin.adh.ut
+    } else {
+        [0.0; 2]
+    };
+    PointSolution {
+        r_dry: fin.r_dry,
+        r_adh: fin.r_adh,
+        x: fin.x,
+        beta: fin.adh.beta,
+        ut,
+        state,
+        iterations,
+        converged,
+    }
+}
+
+/// Evaluates x, the adhesive part and the projection at the dry force `r_dry`, solving the
+/// adhesive sub-problem from the adhesive-force guess `z_start`.
+fn evaluate(ctx: &Ctx, r_dry: V3, z_start: V3) -> Eval {
+    let p = ctx.p;
+    let y = add(p.x_free, matvec(p.w_aa, r_dry));
+    let (x, r_adh, adh) = match &p.law.adhesion {
+        Some(a) => solve_adhesion(ctx, a, y, z_start),
+        None => (y, [0.0; 3], AdhEval::default()),
+    };
+    let r_star = bipotential_trial(r_dry, x, ctx.mu, p.rho);
+    let (proj, case) = dry_projection(r_star, ctx.mu);
+    Eval {
+        r_dry,
+        x,
+        r_adh,
+        adh,
+        r_star,
+        proj,
+        case,
+        f: sub(r_dry, proj),
+    }
+}
+
+/// Stretch energy density E = C_n x_n⁺² + C_t ‖u_t‖² [N/m].
+fn stretch_energy(p: &RccParams, xn: f64, ut: [f64; 2]) -> f64 {
+    let xp = xn.max(0.0);
+    p.cn * xp * xp + p.ct * (ut[0] * ut[0] + ut[1] * ut[1])
+}
+
+/// β₁ and c = −(∂β₁/∂E)/β₁ [m/N] (0 where β₁ is clamped, cut or frozen).
+fn beta_step(beta0: f64, dt: f64, p: &RccParams, e: f64) -> (f64, f64) {
+    let beta0 = clamp01(beta0);
+    let w = p.w.max(0.0);
+    let target = if e > 0.0 {
+        (w / e).min(1.0)
+    } else if w > 0.0 {
+        1.0
+    } else {
+        beta0
+    };
+    let (raw, c) = if p.b > 0.0 {
+        if dt > 0.0 {
+            let den = p.b + dt * e;
+            ((p.b * beta0 + dt * w) / den, dt / den)
+        } else {
+            (beta0, 0.0)
+        }
+    } else if e > 0.0 {
+        (w / e, 1.0 / e)
+    } else {
+        (target, 0.0)
+    };
+    if raw >= 1.0 {
+        return (1.0, 0.0);
+    }
+    let beta = clamp01(raw);
+    if beta < p.eps && target < p.eps {
+        (0.0, 0.0)
+    } else {
+        (beta, c)
+    }
+}
+
+/// The adhesive law at x: β₁, u_t, r̃, −∂r̃/∂x and the incremental potential
+/// φ = A [½ E β₁² − w β₁ + b/(2Δt) (β₁ − β₀)²] (β₁ minimises the bracket over [0, 1], so
+/// ∂φ/∂x = A β₁² ∂E/∂x / 2 = −r̃).
+fn adhesion_eval(p: &PointProblem, a: &RccParams, x: V3) -> AdhEval {
+    let ut = [p.bond0.ut[0] + x[0], p.bond0.ut[1] + x[1]];
+    let e = stretch_energy(a, x[2], ut);
+    let (beta, c) = beta_step(p.bond0.beta, p.dt, a, e);
+    let force = adhesive_force(beta, a, x[2], ut, p.area);
+    let xp = x[2].max(0.0);
+    let mut energy = 0.5 * e * beta * beta - a.w.max(0.0) * beta;
+    if a.b > 0.0 && p.dt > 0.0 {
+        let d = beta - clamp01(p.bond0.beta);
+        energy += 0.5 * a.b / p.dt * d * d;
+    }
+    energy *= p.area;
+    let mut stiff = [[0.0; 3]; 3];
+    if beta > 0.0 {
+        let k = p.area * beta * beta;
+        let v = [a.ct * ut[0], a.ct * ut[1], a.cn * xp];
+        let dn = if x[2] > 0.0 { a.cn } else { 0.0 };
+        let diag = [a.ct, a.ct, dn];
+        for i in 0..3 {
+            for j in 0..3 {
+                let d = if i == j { diag[i] } else { 0.0 };
+                stiff[i][j] = k * (d - 4.0 * c * v[i] * v[j]);
+            }
+        }
+    }
+    AdhEval {
+        beta,
+        ut,
+        force,
+        stiff,
+        energy,
+    }
+}
+
+/// Adhesive force guess with β frozen at β₀ (linear springs), given y = x_free + W r̄:
+/// z = −K₀ (y + e + W z), K₀ = A β₀² diag(C_t, C_t, C_n [y_n > 0]), e = (u_t0, 0).
+fn frozen_adhesion_guess(p: &PointProblem, y: V3) -> V3 {
+    let a = match &p.law.adhesion {
+        Some(a) => a,
+        None => return [0.0; 3],
+    };
+    let b0 = clamp01(p.bond0.beta);
+    let k = p.area * b0 * b0;
+    if !(k > 0.0) {
+        return [0.0; 3];
+    }
+    let kd = [k * a.ct, k * a.ct, if y[2] > 0.0 { k * a.cn } else { 0.0 }];
+    let rhs = [
+        -kd[0] * (y[0] + p.bond0.ut[0]),
+        -kd[1] * (y[1] + p.bond0.ut[1]),
+        -kd[2] * y[2],
+    ];
+    let mut m = identity();
+    for i in 0..3 {
+        for j in 0..3 {
+            m[i][j] += kd[i] * p.w_aa[i][j];
+        }
+    }
+    match solve3(m, rhs) {
+        Some(z) if z.iter().all(|v| v.is_finite()) => z,
+        _ => [0.0; 3],
+    }
+}
+
+/// Solves z = r̃(y + W z) for the adhesive force z [N] by Newton's method on the potential
+/// Π(z) = ½ zᵀW z + φ(y + W z), whose stationary points are the solutions; the line search keeps
+/// Π decreasing, so the iteration settles in a local minimum (a stable equilibrium) next to the
+/// starting guess and, past a snap-off, slides down to the detached branch.
+fn solve_adhesion(ctx: &Ctx, a: &RccParams, y: V3, z_start: V3) -> (V3, V3, AdhEval) {
+    let p = ctx.p;
+    let w = p.w_aa;
+    let mut z = if z_start.iter().all(|v| v.is_finite()) {
+        z_start
+    } else {
+        [0.0; 3]
+    };
+    let mut x = add(y, matvec(w, z));
+    let mut ad = adhesion_eval(p, a, x);
+    for _ in 0..MAX_INNER {
+        let res = sub(z, ad.force);
+        let size = norm(z) + norm(ad.force) + ctx.scale;
+        if norm(res) <= ctx.tol_in * size {
+            break;
+        }
+        let grad = matvec(w, res);
+        let mut dir = None;
+        let mut m = identity();
+        let kw = matmul(ad.stiff, w);
+        for i in 0..3 {
+            for j in 0..3 {
+                m[i][j] += kw[i][j];
+            }
+        }
+        if let Some(d) = solve3(m, neg(res)) {
+            if dot(grad, d) <= 0.0 && d.iter().all(|v| v.is_finite()) {
+                dir = Some(d);
+            }
+        }
+        let d = match dir {
+            Some(d) => d,
+            None => match shifted_newton_direction(w, ad.stiff, grad) {
+                Some(d) => d,
+                None => neg(res),
+            },
+        };
+        let pi0 = merit(z, w, ad.energy);
+        let slope = dot(grad, d);
+        let mut alpha = 1.0;
+        let mut accepted = None;
+        for _ in 0..MAX_HALVINGS {
+            let zt = axpy(z, alpha, d);
+            let xt = add(y, matvec(w, zt));
+            let at = adhesion_eval(p, a, xt);
+            let pit = merit(zt, w, at.energy);
+            let slack = 1e-13 * (pi0.abs() + pit.abs());
+            if pit <= pi0 + 1e-4 * alpha * slope + slack {
+                accepted = Some((zt, xt, at));
+                break;
+            }
+            alpha *= 0.5;
+        }
+        let (zn, xn, an) = accepted.unwrap_or_else(|| {
+            let zt = add(z, d);
+            let xt = add(y, matvec(w, zt));
+            (zt, xt, adhesion_eval(p, a, xt))
+        });
+        let moved = norm(sub(zn, z));
+        z = zn;
+        x = xn;
+        ad = an;
+        if moved <= 1e-15 * (norm(z) + ctx.scale) {
+            break;
+        }
+    }
+    (x, z, ad)
+}
+
+/// Π(z) = ½ zᵀ W z + φ [J].
+fn merit(z: V3, w: M3, energy: f64) -> f64 {
+    0.5 * dot(z, matvec(w, z)) + energy
+}
+
+/// Descent direction from the Hessian of Π in z, H = W + W K W, shifted to be positive definite
+/// when the interface softens.
+fn shifted_newton_direction(w: M3, k: M3, grad: V3) -> Option<V3> {
+    let h = sym(add_m(w, matmul(w, matmul(k, w))));
+    let ev = eig_sym3(h);
+    let big = ev[0].abs().max(ev[2].abs());
+    if !(big > 0.0) || !big.is_finite() {
+        return None;
+    }
+    let shift = (-ev[0]).max(0.0) + 1e-6 * big;
+    let mut hs = h;
+    for (i, row) in hs.iter_mut().enumerate() {
+        row[i] += shift;
+    }
+    solve3(hs, neg(grad)).filter(|d| d.iter().all(|v| v.is_finite()))
+}
+
+/// Semi-smooth Newton step on F(r̄) = r̄ − Proj(r̄ − ρ g(x(r̄))), g(x) = x + μ‖x_t‖n:
+/// ∂F/∂r̄ = I − P′ (I − ρ G W_e), with P′ the Jacobian of the projection in its case,
+/// G = ∂g/∂x and W_e = (I + W K)⁻¹ W the compliance seen by r̄ with the adhesive part solved.
+fn newton_step(ctx: &Ctx, ev: &Eval) -> Option<V3> {
+    let p = ctx.p;
+    let mut m = identity();
+    let wk = matmul(p.w_aa, ev.adh.stiff);
+    for i in 0..3 {
+        for j in 0..3 {
+            m[i][j] += wk[i][j];
+        }
+    }
+    let we = solve3_mat(m, p.w_aa)?;
+    let mut g = identity();
+    let xt = norm2(ev.x[0], ev.x[1]);
+    if xt > 0.0 && ctx.mu > 0.0 {
+        g[2][0] = ctx.mu * ev.x[0] / xt;
+        g[2][1] = ctx.mu * ev.x[1] / xt;
+    }
+    let gw = matmul(g, we);
+    let mut a = identity();
+    for i in 0..3 {
+        for j in 0..3 {
+            a[i][j] -= p.rho * gw[i][j];
+        }
+    }
+    let pj = projection_jacobian(ev.r_star, ctx.mu, ev.case);
+    let pa = matmul(pj, a);
+    let mut jac = identity();
+    for i in 0..3 {
+        for j in 0..3 {
+            jac[i][j] -= pa[i][j];
+        }
+    }
+    solve3(jac, neg(ev.f)).filter(|d| d.iter().all(|v| v.is_finite()))
+}
+
+/// Jacobian of [`dry_projection`] at `r_star` in the given case.
+fn projection_jacobian(r_star: V3, mu: f64, case: ContactState) -> M3 {
+    match case {
+        ContactState::Apart => [[0.0; 3]; 3],
+        ContactState::Stick => identity(),
+        ContactState::Slide => {
+            let s = norm2(r_star[0], r_star[1]);
+            let q = 1.0 + mu * mu;
+            if !(s > 0.0) {
+                let mut j = [[0.0; 3]; 3];
+                j[2][2] = 1.0 / q;
+                return j;
+            }
+            let t = [r_star[0] / s, r_star[1] / s];
+            let rn = ((r_star[2] + mu * s) / q).max(0.0);
+            let mut j = [[0.0; 3]; 3];
+            for a in 0..2 {
+                for b in 0..2 {
+                    let delta = if a == b { 1.0 } else { 0.0 };
+                    j[a][b] = mu * mu * t[a] * t[b] / q + mu * rn / s * (delta - t[a] * t[b]);
+                }
+                j[a][2] = mu * t[a] / q;
+                j[2][a] = mu * t[a] / q;
+            }
+            j[2][2] = 1.0 / q;
+            j
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Small dense helpers on [f64; 3] and [[f64; 3]; 3].
+
+fn clamp01(v: f64) -> f64 {
+    if v > 1.0 {
+        1.0
+    } else if v > 0.0 {
+        v
+    } else {
+        0.0
+    }
+}
+
+fn norm2(a: f64, b: f64) -> f64 {
+    a.hypot(b)
+}
+
+fn norm(v: V3) -> f64 {
+    dot(v, v).sqrt()
+}
+
+fn dot(a: V3, b: V3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn add(a: V3, b: V3) -> V3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+fn sub(a: V3, b: V3) -> V3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn neg(a: V3) -> V3 {
+    [-a[0], -a[1], -a[2]]
+}
+
+fn axpy(a: V3, s: f64, b: V3) -> V3 {
+    [a[0] + s * b[0], a[1] + s * b[1], a[2] + s * b[2]]
+}
+
+fn identity() -> M3 {
+    [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+}
+
+fn matvec(m: M3, v: V3) -> V3 {
+    [dot(m[0], v), dot(m[1], v), dot(m[2], v)]
+}
+
+fn matmul(a: M3, b: M3) -> M3 {
+    let mut c = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            c[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j];
+        }
+    }
+    c
+}
+
+fn add_m(a: M3, b: M3) -> M3 {
+    let mut c = a;
+    for i in 0..3 {
+        for j in 0..3 {
+            c[i][j] += b[i][j];
+        }
+    }
+    c
+}
+
+fn sym(a: M3) -> M3 {
+    let mut s = a;
+    for i in 0..3 {
+        for j in 0..3 {
+            s[i][j] = 0.5 * (a[i][j] + a[j][i]);
+        }
+    }
+    s
+}
+
+/// Solves m x = b by Gaussian elimination with partial pivoting; `None` when m is singular to
+/// working precision.
+fn solve3(m: M3, b: V3) -> Option<V3> {
+    let mut a = m;
+    let mut r = b;
+    let big = a
+        .iter()
+        .flat_map(|row| row.iter())
+        .fold(0.0_f64, |acc, v| acc.max(v.abs()));
+    if !(big > 0.0) || !big.is_finite() {
+        return None;
+    }
+    for col in 0..3 {
+        let mut piv = col;
+        for row in col + 1..3 {
+            if a[row][col].abs() > a[piv][col].abs() {
+                piv = row;
+            }
+        }
+        if !(a[piv][col].abs() > 1e-14 * big) {
+            return None;
+        }
+        a.swap(col, piv);
+        r.swap(col, piv);
+        for row in col + 1..3 {
+            let f = a[row][col] / a[col][col];
+            for k in col..3 {
+                a[row][k] -= f * a[col][k];
+            }
+            r[row] -= f * r[col];
+        }
+    }
+    let mut x = [0.0; 3];
+    for i in (0..3).rev() {
+        let mut s = r[i];
+        for k in i + 1..3 {
+            s -= a[i][k] * x[k];
+        }
+        x[i] = s / a[i][i];
+    }
+    Some(x)
+}
+
+/// Solves m X = b column by column.
+fn solve3_mat(m: M3, b: M3) -> Option<M3> {
+    let mut out = [[0.0; 3]; 3];
+    for j in 0..3 {
+        let col = solve3(m, [b[0][j], b[1][j], b[2][j]])?;
+        for i in 0..3 {
+            out[i][j] = col[i];
+        }
+    }
+    Some(out)
+}
+
+/// Eigenvalues of a symmetric 3×3 matrix in ascending order (trigonometric closed form).
+fn eig_sym3(a: M3) -> V3 {
+    let p1 = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+    let q = (a[0][0] + a[1][1] + a[2][2]) / 3.0;
+    let d = [a[0][0] - q, a[1][1] - q, a[2][2] - q];
+    let p2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + 2.0 * p1;
+    let p = (p2 / 6.0).sqrt();
+    if !(p > 0.0) {
+        return [q, q, q];
+    }
+    let mut b = a;
+    for (i, row) in b.iter_mut().enumerate() {
+        for (j, v) in row.iter_mut().enumerate() {
+            *v = (*v - if i == j { q } else { 0.0 }) / p;
+        }
+    }
+    let det = b[0][0] * (b[1][1] * b[2][2] - b[1][2] * b[2][1])
+        - b[0][1] * (b[1][0] * b[2][2] - b[1][2] * b[2][0])
+        + b[0][2] * (b[1][0] * b[2][1] - b[1][1] * b[2][0]);
+    let phi = (0.5 * det).clamp(-1.0, 1.0).acos() / 3.0;
+    let l_hi = q + 2.0 * p * phi.cos();
+    let l_lo = q + 2.0 * p * (phi + 2.0 * PI / 3.0).cos();
+    let l_mid = 3.0 * q - l_hi - l_lo;
+    [l_lo, l_mid, l_hi]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Deterministic generator for randomised tests (splitmix64).
+    struct Rng(u64);
+
+    impl Rng {
+        fn next_u64(&mut self) -> u64 {
+            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = self.0;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^ (z >> 31)
+        }
+
+        fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+            let u = (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+            lo + (hi - lo) * u
+        }
+
+        /// Random symmetric positive definite matrix with eigenvalues in [lo, hi].
+        fn spd(&mut self, lo: f64, hi: f64) -> M3 {
+            let mut q = [[0.0; 3]; 3];
+            for row in q.iter_mut() {
+                for v in row.iter_mut() {
+                    *v = self.uniform(-1.0, 1.0);
+                }
+            }
+            // Gram-Schmidt on the rows.
+            for i in 0..3 {
+                for k in 0..i {
+                    let d = dot(q[i], q[k]);
+                    q[i] = axpy(q[i], -d, q[k]);
+                }
+                let n = norm(q[i]);
+                q[i] = [q[i][0] / n, q[i][1] / n, q[i][2] / n];
+            }
+            let l = [lo, self.uniform(lo, hi), hi];
+            let mut m = [[0.0; 3]; 3];
+            for i in 0..3 {
+                for j in 0..3 {
+                    m[i][j] = (0..3).map(|k| q[k][i] * l[k] * q[k][j]).sum();
+                }
+            }
+            m
+        }
+    }
+
+    fn diag(a: f64, b: f64, c: f64) -> M3 {
+        [[a, 0.0, 0.0], [0.0, b, 0.0], [0.0, 0.0, c]]
+    }
+
+    fn rel(a: f64, b: f64) -> f64 {
+        (a - b).abs() / b.abs().max(f64::MIN_POSITIVE)
+    }
+
+    fn assert_vec_close(a: V3, b: V3, tol: f64) {
+        let s = norm(a).max(norm(b)).max(f64::MIN_POSITIVE);
+        assert!(norm(sub(a, b)) <= tol * s, "{a:?} vs {b:?} (tol {tol})");
+    }
+
+    const DRY: InterfaceLaw = InterfaceLaw {
+        mu: 0.3,
+        adhesion: None,
+    };
+
+    /// Paper-like interface: w = 20 J/m², C_n = C_t = 2e9 N/m³ (x_c = 0.1 mm), b = 0.1 N·s/m.
+    fn paper_rcc() -> RccParams {
+        RccParams::new(20.0, 2e9, 2e9, 0.1)
+    }
+
+    fn problem<'a>(law: &'a InterfaceLaw, w: M3, x_free: V3, bond0: BondState) -> PointProblem<'a> {
+        PointProblem {
+            w_aa: w,
+            x_free,
+            law,
+            bond0,
+            dt: 1e-4,
+            area: 1e-6,
+            rho: default_rho(w),
+        }
+    }
+
+    /// Independent check of a point solution against the laws of model.md §5: x = x_free + W r,
+    /// r̄ ∈ K_μ, Signorini complementarity, Coulomb sliding rule, and the RCC part.
+    fn check_solution(p: &PointProblem, s: &PointSolution, tol: f64) {
+        let r = s.r();
+        let x = add(p.x_free, matvec(p.w_aa, r));
+        let xs = norm(p.x_free).max(norm(x)).max(f64::MIN_POSITIVE);
+        let parts = xs + norm(matvec(p.w_aa, s.r_dry)) + norm(matvec(p.w_aa, s.r_adh));
+        assert!(
+            norm(sub(x, s.x)) <= 1e-12 * parts,
+            "x = x_free + W r: {x:?} vs {:?} ({s:?}, {p:?})",
+            s.x
+        );
+        let mu = p.law.mu;
+        let fs = norm(r) + p.rho * norm(p.x_free);
+        let rd = s.r_dry;
+        assert!(rd[2] >= 0.0, "dry normal force is compressive");
+        assert!(norm2(rd[0], rd[1]) <= mu * rd[2] * (1.0 + 1e-12) + 1e-300);
+        let xt = norm2(x[0], x[1]);
+        match s.state {
+            ContactState::Apart => {
+                assert_eq!(rd, [0.0; 3]);
+                assert!(x[2] >= -tol * xs, "apart means open gap: {}", x[2]);
+            }
+            ContactState::Stick => {
+                assert!(x[2].abs() <= tol * xs, "stick gap {}", x[2]);
+                assert!(xt <= tol * xs, "stick slip {xt}");
+            }
+            ContactState::Slide => {
+                assert!(x[2].abs() <= tol * xs, "slide gap {}", x[2]);
+                let rt = norm2(rd[0], rd[1]);
+                assert!((rt - mu * rd[2]).abs() <= tol * fs, "on the cone");
+                if rt > tol * fs && xt > tol * xs {
+                    let c = (rd[0] * x[0] + rd[1] * x[1]) / (rt * xt);
+                    assert!(c < -1.0 + 1e-6, "friction opposes slip: cos = {c}");
+                }
+            }
+        }
+        match &p.law.adhesion {
+            None => assert_eq!(s.r_adh, [0.0; 3]),
+            Some(a) => {
+                let ut = [p.bond0.ut[0] + x[0], p.bond0.ut[1] + x[1]];
+                let beta = beta_update(p.bond0.beta, p.dt, a, x[2], ut);
+                assert!((beta - s.beta).abs() <= 1e-9, "β {beta} vs {}", s.beta);
+                let ra = adhesive_force(beta, a, x[2], ut, p.area);
+                let scale = norm(ra) + p.area * a.peak_traction();
+                assert!(
+                    norm(sub(ra, s.r_adh)) <= tol * scale,
+                    "{ra:?} vs {:?}",
+                    s.r_adh
+                );
+            }
+        }
+    }
+
+    // ------------------------------------------------------------------ projection
+
+    #[test]
+    fn projection_cases_match_hand_values() {
+        // Separating: μ‖r*_t‖ = 0.05 < 1 = −r*_n.
+        let (r, c) = dry_projection([0.1, 0.0, -1.0], 0.5);
+        assert_eq!((r, c), ([0.0; 3], ContactState::Apart));
+        // Sticking: ‖r*_t‖ = 0.5 ≤ 1 = μ r*_n.
+        let (r, c) = dry_projection([0.3, 0.4, 2.0], 0.5);
+        assert_eq!((r, c), ([0.3, 0.4, 2.0], ContactState::Stick));
+        // Sliding, model.md's example: μ = 1, r* = (2, 0, 0) → r_n = 1, r_t = (1, 0).
+        let (r, c) = dry_projection([2.0, 0.0, 0.0], 1.0);
+        assert_eq!(c, ContactState::Slide);
+        assert_vec_close(r, [1.0, 0.0, 1.0], 1e-15);
+        // Sliding: μ = 0.5, r* = (3, 4, 1): r_n = (1 + 2.5)/1.25 = 2.8, r_t = 1.4 (0.6, 0.8).
+        let (r, c) = dry_projection([3.0, 4.0, 1.0], 0.5);
+        assert_eq!(c, ContactState::Slide);
+        assert_vec_close(r, [0.84, 1.12, 2.8], 1e-15);
+        // Sliding from below the apex plane: μ = 2, r* = (3, 0, −1): r_n = (−1 + 6)/5 = 1.
+        let (r, c) = dry_projection([3.0, 0.0, -1.0], 2.0);
+        assert_eq!(c, ContactState::Slide);
+        assert_vec_close(r, [2.0, 0.0, 1.0], 1e-15);
+    }
+
+    #[test]
+    fn projection_frictionless() {
+        let (r, c) = dry_projection([1.0, -2.0, 3.0], 0.0);
+        assert_eq!((r, c), ([0.0, 0.0, 3.0], ContactState::Slide));
+        let (r, c) = dry_projection([1.0, -2.0, -3.0], 0.0);
+        assert_eq!((r, c), ([0.0; 3], ContactState::Apart));
+        let (r, c) = dry_projection([0.0, 0.0, 3.0], 0.0);
+        assert_eq!((r, c), ([0.0, 0.0, 3.0], ContactState::Stick));
+        // Negative μ is treated as 0.
+        assert_eq!(dry_projection([1.0, 0.0, 1.0], -0.5).0, [0.0, 0.0, 1.0]);
+    }
+
+    #[test]
+    fn sliding_projection_is_orthogonal_closed_form() {
+        // r* − r = (‖r*_t‖ − μ r*_n)/(1 + μ²) (t̂, −μ): normal to the cone's generator (μ t̂, 1)
+        // through r, and r itself lies on that generator.
+        let mu = 0.7;
+        let rs = [1.5, -2.0, 0.4];
+        let (r, c) = dry_projection(rs, mu);
+        assert_eq!(c, ContactState::Slide);
+        let st = norm2(rs[0], rs[1]);
+        let t = [rs[0] / st, rs[1] / st];
+        let k = (st - mu * rs[2]) / (1.0 + mu * mu);
+        assert_vec_close(sub(rs, r), [k * t[0], k * t[1], -k * mu], 1e-14);
+        let gen = [mu * t[0], mu * t[1], 1.0];
+        assert!(dot(sub(rs, r), gen).abs() <= 1e-14 * norm(rs));
+        let rn = r[2];
+        assert_vec_close(r, [rn * gen[0], rn * gen[1], rn * gen[2]], 1e-14);
+    }
+
+    #[test]
+    fn paper_plus_sign_would_leave_the_cone() {
+        // Eq 32 as printed: r = r* − (‖r*_t‖ − μ r*_n)/(1 + μ²) (t̂ + μ n).
+        let (mu, rs) = (1.0, [2.0, 0.0, 0.0]);
+        let k = (2.0 - mu * 0.0) / (1.0 + mu * mu);
+        let printed = [rs[0] - k, rs[1], rs[2] - k * mu];
+        assert!(printed[2] < 0.0, "printed sign gives r_n = {}", printed[2]);
+        let (ours, _) = dry_projection(rs, mu);
+        assert!(ours[2] > 0.0 && (norm2(ours[0], ours[1]) - mu * ours[2]).abs() < 1e-15);
+    }
+
+    #[test]
+    fn projection_random_properties() {
+        let mut rng = Rng(7);
+        let mut hits = [0usize; 3];
+        for i in 0..20_000 {
+            let mu = if i % 10 == 0 {
+                0.0
+            } else {
+                rng.uniform(0.0, 1.5)
+            };
+            let mag = 10f64.powf(rng.uniform(-6.0, 6.0));
+            let rs = [
+                mag * rng.uniform(-1.0, 1.0),
+                mag * rng.uniform(-1.0, 1.0),
+                mag * rng.uniform(-1.0, 1.0),
+            ];
+            let (r, c) = dry_projection(rs, mu);
+            hits[c as usize] += 1;
+            let s = norm(rs);
+            let tol = 1e-12 * s;
+            // In the cone.
+            assert!(r[2] >= 0.0);
+            assert!(norm2(r[0], r[1]) <= mu * r[2] + tol, "{rs:?} μ={mu}");
+            // Idempotent.
+            let (rr, cc) = dry_projection(r, mu);
+            assert!(norm(sub(rr, r)) <= tol, "idempotence {rs:?} μ={mu}");
+            if norm(r) > 0.0 {
+                assert_ne!(cc, ContactState::Apart);
+            }
+            // Moreau: y = r* − r lies in the polar cone {μ‖y_t‖ ≤ −y_n} and y ⊥ r.
+            let y = sub(rs, r);
+            assert!(mu * norm2(y[0], y[1]) + y[2] <= tol, "polar {rs:?} μ={mu}");
+            assert!(
+                dot(y, r).abs() <= 1e-12 * s * s,
+                "orthogonality {rs:?} μ={mu}"
+            );
+            // Nearest point: no random point of the cone is closer.
+            let d = norm(y);
+            for _ in 0..4 {
+                let kn = mag * rng.uniform(0.0, 2.0);
+                let ang = rng.uniform(0.0, 2.0 * PI);
+                let kt = mu * kn * rng.uniform(0.0, 1.0);
+                let k = [kt * ang.cos(), kt * ang.sin(), kn];
+                assert!(norm(sub(rs, k)) >= d - tol);
+            }
+        }
+        assert!(hits.iter().all(|&h| h > 1000), "all cases hit: {hits:?}");
+    }
+
+    #[test]
+    fn bipotential_trial_by_hand() {
+        // r* = r̄ − ρ (x + μ‖x_t‖ n): ‖x_t‖ = 5e-3, μ‖x_t‖ = 2.5e-3.
+        let r = bipotential_trial([1.0, 2.0, 3.0], [3e-3, -4e-3, 1e-3], 0.5, 100.0);
+        assert_vec_close(r, [0.7, 2.4, 3.0 - 0.35], 1e-15);
+    }
+
+    // ------------------------------------------------------------------ β and adhesive force
+
+    #[test]
+    fn bonding_in_closed_contact_is_linear_in_time() {
+        let p = paper_rcc();
+        let dt = 1.5e-4; // Δt w/b = 0.03
+        let mut beta = 0.0;
+        for k in 1..=50 {
+            beta = beta_update(beta, dt, &p, 0.0, [0.0; 2]);
+            let expect = (k as f64 * dt * p.w / p.b).min(1.0);
+            assert!(
+                (beta - expect).abs() <= 1e-13,
+                "step {k}: {beta} vs {expect}"
+            );
+        }
+        assert_eq!(beta, 1.0);
+        // A negative gap stretches nothing.
+        assert!((beta_update(0.0, dt, &p, -1e-3, [0.0; 2]) - 0.03).abs() <= 1e-15);
+    }
+
+    #[test]
+    fn bonding_survives_steps_below_the_cut_off() {
+        // Δt w/b = 1e-6 < ε: each step's β is below ε but the bond is forming (β∞ = 1).
+        let p = paper_rcc();
+        let dt = 5e-9;
+        let mut beta = 0.0;
+        for _ in 0..1000 {
+            beta = beta_update(beta, dt, &p, 0.0, [0.0; 2]);
+        }
+        assert!((beta - 1e-3).abs() <= 1e-12, "{beta}");
+    }
+
+    #[test]
+    fn held_opening_converges_at_first_order() {
+        let p = paper_rcc();
+        let x = 2.0 * p.critical_opening();
+        let binf = p.w / (p.cn * x * x);
+        assert!((binf - 0.25).abs() < 1e-12);
+        let tau = p.b / (p.cn * x * x);
+        let t_end = 2.0 * tau;
+        let exact = binf + (1.0 - binf) * (-t_end / tau).exp();
+        let err = |n: usize| {
+            let dt = t_end / n as f64;
+            let mut b = 1.0;
+            for _ in 0..n {
+                b = beta_update(b, dt, &p, x, [0.0; 2]);
+            }
+            (b - exact).abs()
+        };
+        let e = [err(40), err(80), err(160)];
+        let o1 = (e[0] / e[1]).log2();
+        let o2 = (e[1] / e[2]).log2();
+        assert!(
+            (0.9..=1.1).contains(&o1) && (0.9..=1.1).contains(&o2),
+            "{o1} {o2}"
+        );
+        assert!(e[2] < 2e-3, "error {}", e[2]);
+        // Long hold: the equilibrium β∞ is reached.
+        let mut b = 1.0;
+        for _ in 0..200 {
+            b = beta_update(b, tau, &p, x, [0.0; 2]);
+        }
+        assert!(rel(b, binf) < 1e-12);
+        // The same with a tangential stretch: E = C_t ‖u_t‖² only.
+        let mut b = 1.0;
+        for _ in 0..200 {
+            b = beta_update(b, tau, &p, 0.0, [0.6 * x, 0.8 * x]);
+        }
+        assert!(rel(b, binf) < 1e-12);
+    }
+
+    #[test]
+    fn rate_independent_limit() {
+        let mut p = paper_rcc();
+        p.b = 0.0;
+        let xc = p.critical_opening();
+        for f in [0.0, 0.5, 1.0, 1.5, 3.0, 20.0, 99.0] {
+            let x = f * xc;
+            let expect = if x > 0.0 {
+                (p.w / (p.cn * x * x)).min(1.0)
+            } else {
+                1.0
+            };
+            for dt in [1e-3, 0.0] {
+                let b = beta_update(0.3, dt, &p, x, [0.0; 2]);
+                assert!(rel(b, expect) < 1e-14, "x = {f} x_c: {b} vs {expect}");
+            }
+        }
+        let b = beta_update(0.0, 1.0, &p, xc, [xc, 0.0]);
+        assert!(rel(b, 0.5) < 1e-14);
+    }
+
+    #[test]
+    fn cut_off() {
+        let p = paper_rcc();
+        let xc = p.critical_opening();
+        // A decaying bond that falls below ε is broken.
+        let x = 200.0 * xc; // β∞ = 2.5e-5 < ε
+        assert_eq!(beta_update(2e-4, 1.0, &p, x, [0.0; 2]), 0.0);
+        // Still above ε: kept.
+        let b = beta_update(2e-4, 1e-9, &p, x, [0.0; 2]);
+        assert!(b > 1e-4 && b < 2e-4);
+        // β₀ = 0 far away: no bond.
+        assert_eq!(beta_update(0.0, 1e-3, &p, x, [0.0; 2]), 0.0);
+        // β₀ = 0 within √(w/(ε C_n)) = 100 x_c: the bond forms, per the law.
+        let x = 50.0 * xc; // β∞ = 4e-4
+        let dt = 1e-7;
+        let b = beta_update(0.0, dt, &p, x, [0.0; 2]);
+        let expect = dt * p.w / (p.b + dt * p.cn * x * x);
+        assert!(b < p.eps && rel(b, expect) < 1e-14, "{b} vs {expect}");
+        let dt = 1e-3;
+        // Rate-independent: β = β∞ cut at ε.
+        let mut q = p;
+        q.b = 0.0;
+        assert_eq!(beta_update(0.0, dt, &q, 200.0 * xc, [0.0; 2]), 0.0);
+        assert!(rel(beta_update(0.0, dt, &q, x, [0.0; 2]), 4e-4) < 1e-12);
+        // A larger ε cuts more.
+        q.eps = 1e-3;
+        assert_eq!(beta_update(0.0, dt, &q, x, [0.0; 2]), 0.0);
+    }
+
+    #[test]
+    fn beta_stays_in_unit_interval() {
+        let mut rng = Rng(11);
+        for _ in 0..10_000 {
+            let p = RccParams {
+                w: rng.uniform(0.0, 50.0),
+                cn: 10f64.powf(rng.uniform(6.0, 12.0)),
+                ct: 10f64.powf(rng.uniform(6.0, 12.0)),
+                b: if rng.uniform(0.0, 1.0) < 0.2 {
+                    0.0
+                } else {
+                    10f64.powf(rng.uniform(-6.0, 1.0))
+                },
+                eps: DEFAULT_BETA_EPS,
+            };
+            let b = beta_update(
+                rng.uniform(-0.5, 1.5),
+                10f64.powf(rng.uniform(-8.0, 0.0)),
+                &p,
+                rng.uniform(-1e-3, 1e-3),
+                [rng.uniform(-1e-3, 1e-3), rng.uniform(-1e-3, 1e-3)],
+            );
+            assert!((0.0..=1.0).contains(&b), "{b}");
+            assert!(b == 0.0 || b >= p.eps || b > 0.0);
+        }
+    }
+
+    #[test]
+    fn adhesive_force_signs_and_values() {
+        let p = paper_rcc();
+        let r = adhesive_force(0.5, &p, 1e-5, [2e-5, -1e-5], 1e-6);
+        // β² A = 2.5e-7: C_n x β² A = 2e9 · 1e-5 · 2.5e-7 = 5e-3 N.
+        assert_vec_close(r, [-1e-2, 5e-3, -5e-3], 1e-14);
+        // Closed gap: no normal adhesive force, tangential one still there.
+        let r = adhesive_force(1.0, &p, -1e-5, [1e-5, 0.0], 1e-6);
+        assert_eq!(r[2], 0.0);
+        assert!(r[0] < 0.0);
+        assert_eq!(adhesive_force(0.0, &p, 1e-5, [1e-5, 1e-5], 1e-6), [0.0; 3]);
+    }
+
+    #[test]
+    fn quasi_static_pull_off() {
+        // b = 1e-6 N·s/m, opening at 0.1 mm/s: b/(Δt E) ≤ 5e-5 beyond x_c, effectively b → 0.
+        let p = RccParams::new(20.0, 2e9, 2e9, 1e-6);
+        let xc = p.critical_opening();
+        let v = 1e-4;
+        let (mut x, mut beta) = (0.0_f64, 1.0);
+        let (mut work, mut t_prev) = (0.0, 0.0);
+        let (mut peak, mut x_peak) = (0.0_f64, 0.0);
+        let mut max_dev = 0.0_f64;
+        while x < 300.0 * xc {
+            // Uniform steps of x_c/1000 up to 3 x_c, then 0.1 % geometric growth.
+            let dx = if x < 3.0 * xc { 1e-3 * xc } else { 1e-3 * x };
+            x += dx;
+            beta = beta_update(beta, dx / v, &p, x, [0.0; 2]);
+            let t = -adhesive_force(beta, &p, x, [0.0; 2], 1.0)[2];
+            let b_qs = (p.w / (p.cn * x * x)).min(1.0);
+            let t_qs = p.cn * x * b_qs * b_qs;
+            if b_qs >= p.eps {
+                max_dev = max_dev.max((t - t_qs).abs() / p.peak_traction());
+            }
+            work += 0.5 * (t + t_prev) * dx;
+            t_prev = t;
+            if t > peak {
+                peak = t;
+                x_peak = x;
+            }
+        }
+        assert!(max_dev < 1e-3, "traction deviates by {max_dev} of the peak");
+        assert!(rel(peak, (p.cn * p.w).sqrt()) < 1e-3, "peak {peak}");
+        assert!(
+            (x_peak - xc).abs() <= 2e-3 * xc,
+            "peak at {} x_c",
+            x_peak / xc
+        );
+        assert!(rel(work, p.w) < 2e-3, "work {work} vs w = {}", p.w);
+        assert_eq!(beta, 0.0, "the bond is broken at 300 x_c");
+    }
+
+    // ------------------------------------------------------------------ point solver
+
+    #[test]
+    fn dbg_case() {
+        let law = InterfaceLaw {
+            mu: 1.2,
+            adhesion: Some(RccParams {
+                w: 20.0,
+                cn: 2000000000.0,
+                ct: 2000000000.0,
+                b: 1e-6,
+                eps: 0.0001,
+            }),
+        };
+        let p = PointProblem {
+            w_aa: [
+                [1.7002235845590745, -0.4678283269036566, 1.3912302746200687],
+                [-0.4678283269036567, 4.930083937426607, 0.28487967169134215],
+                [1.3912302746200687, 0.2848796716913422, 2.2737067430584563],
+            ],
+            x_free: [
+                -0.004875768019883796,
+                0.014494092234334942,
+                -0.017063513770316244,
+            ],
+            law: &law,
+            bond0: BondState {
+                beta: 1.0,
+                ut: [-2.5273372863015965e-5, -2.797668651169949e-5],
+            },
+            dt: 0.0001,
+            area: 1e-6,
+            rho: 0.19999999999999993,
+        };
+        let s = solve_point(&p, [0.0; 3], 1e-10, 30);
+        eprintln!("{s:?}");
+    }
+
+    #[test]
+    fn default_rho_is_inverse_largest_eigenvalue() {
+        let w = [[2.0, 1.0, 0.0], [1.0, 2.0, 0.0], [0.0, 0.0, 1.0]];
+        assert!(rel(default_rho(w), 1.0 / 3.0) < 1e-14);
+        assert!(rel(default_rho(diag(1e-6, 2e-6, 4e-6)), 2.5e5) < 1e-14);
+        assert_eq!(default_rho([[0.0; 3]; 3]), 1.0);
+        let mut rng = Rng(3);
+        for _ in 0..1000 {
+            let hi = 10f64.powf(rng.uniform(-6.9, -3.0));
+            let w = rng.spd(1e-7, hi);
+            let ev = eig_sym3(w);
+            let hi = w
+                .iter()
+                .map(|r| r.iter().map(|v| v.abs()).sum::<f64>())
+                .fold(0.0, f64::max);
+            assert!(ev[2] <= hi * (1.0 + 1e-12) && ev[0] > 0.0);
+            let rho = default_rho(w);
+            assert!(rel(rho * ev[2], 1.0) < 1e-12);
+        }
+    }
+
+    #[test]
+    fn pressed_into_rigid_support() {
+        let w = diag(1e-6, 1e-6, 2e-6);
+        let p = problem(&DRY, w, [0.0, 0.0, -1e-4], BondState::default());
+        let s = solve_point(&p, [0.0; 3], 1e-12, 50);
+        assert!(s.converged);
+        assert_eq!(s.state, ContactState::Stick);
+        assert!(s.x[2].abs() <= 1e-12 * 1e-4, "x_n = {}", s.x[2]);
+        assert!(rel(s.r_dry[2], 1e-4 / 2e-6) < 1e-10, "r_n = {}", s.r_dry[2]);
+        check_solution(&p, &s, 1e-10);
+    }
+
+    #[test]
+    fn stick_then_slide() {
+        let w = diag(1e-6, 1e-6, 2e-6);
+        // Stick: the sticking force 10 N < μ r_n = 15 N.
+        let p = problem(&DRY, w, [1e-5, 0.0, -1e-4], BondState::default());
+        let s = solve_point(&p, [0.0; 3], 1e-12, 50);
+        assert!(s.converged);
+        assert_eq!(s.state, ContactState::Stick);
+        assert!(norm2(s.x[0], s.x[1]) <= 1e-12 * 1e-4);
+        assert_vec_close(s.r(), [-10.0, 0.0, 50.0], 1e-10);
+        check_solution(&p, &s, 1e-10);
+        // Slide: the sticking force would be 50 N > 15 N.
+        let p = problem(&DRY, w, [3e-5, 4e-5, -1e-4], BondState::default());
+        let s = solve_point(&p, [0.0; 3], 1e-12, 50);
+        assert!(s.converged);
+        assert_eq!(s.state, ContactState::Slide);
+        assert_vec_close(s.r(), [-9.0, -12.0, 50.0], 1e-10);
+        assert_vec_close(s.x, [2.1e-5, 2.8e-5, 0.0], 1e-10);
+        check_solution(&p, &s, 1e-10);
+        // Frictionless: r_t = 0, all of x_free_t becomes slip.
+        let law = InterfaceLaw {
+            mu: 0.0,
+            adhesion: None,
+        };
+        let p = problem(&law, w, [3e-5, 4e-5, -1e-4], BondState::default());
+        let s = solve_point(&p, [0.0; 3], 1e-12, 50);
+        assert!(s.converged);
+        assert_vec_close(s.r(), [0.0, 0.0, 50.0], 1e-12);
+        assert_vec_close(s.x, [3e-5, 4e-5, 0.0], 1e-10);
+    }
+
+    #[test]
+    fn apart_without_adhesion_has_no_force() {
+        let w = diag(1e-6, 1e-6, 2e-6);
+        let p = problem(&DRY, w, [1e-5, 0.0, 1e-4], BondState::default());
+        let s = solve_point(&p, [5.0, 0.0, 30.0], 1e-12, 50);
+        assert!(s.converged);
+        assert_eq!(s.state, ContactState::Apart);
+        assert_eq!(s.r(), [0.0; 3]);
+        assert_eq!(s.x, p.x_free);
+        assert!(s.iterations <= 2);
+    }
+
+    #[test]
+    fn bonded_point_opened_slightly_pulls_back() {
+        let law = InterfaceLaw {
+            mu: 0.3,
+            adhesion: Some(paper_rcc()),
+        };
+        let bond = BondState {
+            beta: 1.0,
+            ut: [0.0; 2],
+        };
+        // C_n A = 2e3 N/m; C_n A W_nn = 0.2 (soft) and 100 (stiff adhesion).
+        for wnn in [1e-4, 5e-2] {
+            let w = diag(1e-4, 1e-4, wnn);
+            let p = problem(&law, w, [0.0, 0.0, 1e-5], bond);
+            let s = solve_point(&p, [0.0; 3], 1e-12, 50);
+            assert!(s.converged, "W_nn = {wnn}");
+            let k = 2e9 * 1e-6;
+            let xn = 1e-5 / (1.0 + k * wnn);
+            assert_eq!(s.state, ContactState::Apart);
+            assert_eq!(s.beta, 1.0);
+            assert!(rel(s.x[2], xn) < 1e-10, "x_n {} vs {xn}", s.x[2]);
+            assert!(rel(s.r()[2], -k * xn) < 1e-10);
+            assert!(s.iterations <= 3, "{} iterations", s.iterations);
+            check_solution(&p, &s, 1e-10);
+        }
+    }
+
+    #[test]
+    fn bond_stretch_bookkeeping() {
+        let law = InterfaceLaw {
+            mu: 0.3,
+            adhesion: Some(paper_rcc()),
+        };
+        let w = diag(1e-4, 1e-4, 1e-4);
+        // Bonded, pressed and pulled sideways: stretch grows by the slip, bond survives.
+        let bond = BondState {
+            beta: 1.0,
+            ut: [1e-6, 0.0],
+        };
+        let p = problem(&law, w, [2e-3, 0.0, -1e-3], bond);
+        let s = solve_point(&p, [0.0; 3], 1e-12, 100);
+        assert!(s.converged);
+        assert!(s.beta > 0.0);
+        assert_eq!(s.ut, [1e-6 + s.x[0], s.x[1]]);
+        check_solution(&p, &s, 1e-9);
+        // Far apart with a weak bond: broken, stretch reset.
+        let bond = BondState {
+            beta: 2e-4,
+            ut: [1e-6, 0.0],
+        };
+        let mut p = problem(&law, w, [0.0, 0.0, 3e-2], bond);
+        p.dt = 1.0;
+        let s = solve_point(&p, [0.0; 3], 1e-12, 100);
+        assert!(s.converged);
+        assert_eq!(s.beta, 0.0);
+        assert_eq!(s.ut, [0.0; 2]);
+        assert_eq!(s.r(), [0.0; 3]);
+    }
+
+    /// A set of point problems over stiffness ratios, loadings and bond states.
+    fn sweep_cases(rng: &mut Rng, n: usize, mut f: impl FnMut(&PointProblem, &str)) {
+        let area = 1e-6;
+        for i in 0..n {
+            let ratio = [0.0, 1e-2, 1.0, 100.0, 1e4][i % 5];
+            let coupled = (i / 5) % 2 == 1;
+            // W with λ_max = W_ref; C_n A W_ref = ratio.
+            let wref = if ratio > 0.0 {
+                ratio / (2e9 * area)
+            } else {
+                1e-4
+            };
+            let w = if coupled {
+                rng.spd(wref / 10.0, wref)
+            } else {
+                diag(
+                    wref * rng.uniform(0.3, 1.0),
+                    wref * rng.uniform(0.3, 1.0),
+                    wref,
+                )
+            };
+            let mu = [0.0, 0.2, 0.4, 0.8, 1.2][(i / 10) % 5];
+            let rcc = RccParams::new(20.0, 2e9, 2e9, [0.1, 1e-6, 0.0][(i / 50) % 3]);
+            let law = InterfaceLaw {
+                mu,
+                adhesion: if ratio > 0.0 { Some(rcc) } else { None },
+            };
+            let xc = rcc.critical_opening();
+            let a = 10f64.powf(rng.uniform(-2.0, 0.7)) * xc * (1.0 + ratio);
+            let x_free = [
+                a * rng.uniform(-1.0, 1.0),
+                a * rng.uniform(-1.0, 1.0),
+                a * rng.uniform(-1.0, 1.0),
+            ];
+            let bond = BondState {
+                beta: [0.0, 1.0, 0.5, 0.01][(i / 3) % 4],
+                ut: [xc * rng.uniform(-0.5, 0.5), xc * rng.uniform(-0.5, 0.5)],
+            };
+            let p = PointProblem {
+                w_aa: w,
+                x_free,
+                law: &law,
+                bond0: bond,
+                dt: 1e-4,
+                area,
+                rho: default_rho(w),
+            };
+            let label = format!("case {i}: ratio {ratio}, coupled {coupled}, μ {mu}");
+            f(&p, &label);
+        }
+    }
+
+    #[test]
+    fn converges_fast_over_stiffness_ratios() {
+        let mut rng = Rng(2024);
+        let mut worst = 0;
+        let mut total = 0;
+        let mut count = 0;
+        let mut states = [0usize; 3];
+        sweep_cases(&mut rng, 1500, |p, label| {
+            let s = solve_point(p, [0.0; 3], 1e-10, 50);
+            assert!(s.converged, "{label}: {s:?} {p:?}");
+            check_solution(p, &s, 1e-8);
+            worst = worst.max(s.iterations);
+            total += s.iterations;
+            count += 1;
+            states[s.state as usize] += 1;
+        });
+        let mean = total as f64 / count as f64;
+        assert!(worst <= 12, "worst {worst} iterations");
+        assert!(mean <= 5.0, "mean {mean} iterations");
+        assert!(states.iter().all(|&n| n > 100), "states {states:?}");
+    }
+
+    #[test]
+    fn plain_fixed_point_with_default_rho_converges_for_dry_contact() {
+        // Without the Newton step: the bi-potential fixed point with ρ = 1/λ_max converges (the
+        // reference the accelerated solver must agree with), while ρ = 1/max W_ii can diverge.
+        let mut rng = Rng(99);
+        let mut diverged_with_diag_rho = 0;
+        for i in 0..300 {
+            let w = rng.spd(1e-6, 1e-5);
+            let law = InterfaceLaw {
+                mu: [0.0, 0.3, 0.8][i % 3],
+                adhesion: None,
+            };
+            let x_free = [
+                rng.uniform(-1e-4, 1e-4),
+                rng.uniform(-1e-4, 1e-4),
+                rng.uniform(-1e-4, 1e-4),
+            ];
+            let mut p = problem(&law, w, x_free, BondState::default());
+            let fp = solve_point_impl(&p, [0.0; 3], 1e-10, 20_000, false);
+            assert!(fp.converged, "case {i}");
+            let nw = solve_point(&p, [0.0; 3], 1e-10, 50);
+            assert!(nw.converged);
+            let scale = norm(fp.r()) + p.rho * norm(x_free);
+            assert!(norm(sub(fp.r(), nw.r())) <= 1e-7 * scale, "case {i}");
+            p.rho = 1.0 / w[0][0].max(w[1][1]).max(w[2][2]);
+            let fd = solve_point_impl(&p, [0.0; 3], 1e-10, 20_000, false);
+            if !fd.converged {
+                diverged_with_diag_rho += 1;
+            }
+        }
+        eprintln!("ρ = 1/max W_ii failed in {diverged_with_diag_rho} of 300 cases");
+    }
+
+    #[test]
+    fn stiff_snap_off_and_hysteresis() {
+        // 1-D pull-off through a compliance with C_n A W_nn = 100, quasi-static (b = 1e-6,
+        // Δt = 1 s). The bonded branch x = a/101 holds up to a = 101 x_c, then the point snaps
+        // to x ≈ a with β < ε: broken. Coming back, a bond re-forms at a distance (β∞ ≥ ε below
+        // 100 x_c) and the point stays on the far branch x + 100 x_c⁴/x³ = a until its turning
+        // point a* = (4/3)·300^{1/4} x_c ≈ 5.55 x_c, where it snaps back into the bonded branch.
+        let rcc = RccParams::new(20.0, 2e9, 2e9, 1e-6);
+        let law = InterfaceLaw {
+            mu: 0.3,
+            adhesion: Some(rcc),
+        };
+        let xc = rcc.critical_opening();
+        let w = diag(0.05, 0.05, 0.05);
+        let mut bond = BondState {
+            beta: 1.0,
+            ut: [0.0; 2],
+        };
+        let mut r = [0.0; 3];
+        let mut snap_off = None;
+        let mut snap_back = None;
+        let mut prev_xn = 0.0;
+        let steps: Vec<f64> = (0..=300)
+            .map(|k| 0.5 * k as f64)
+            .chain((0..300).rev().map(|k| 0.5 * k as f64))
+            .collect();
+        for (k, &af) in steps.iter().enumerate() {
+            let mut p = problem(&law, w, [0.0, 0.0, af * xc], bond);
+            p.dt = 1.0;
+            let s = solve_point(&p, r, 1e-12, 50);
+            assert!(s.converged, "step {k}");
+            check_solution(&p, &s, 1e-9);
+            let xn = s.x[2];
+            let loading = k <= 300;
+            if loading && snap_off.is_none() && xn > 10.0 * xc {
+                snap_off = Some(af);
+            }
+            if !loading && snap_back.is_none() && xn < 2.0 * xc && prev_xn > 2.0 * xc {
+                snap_back = Some(af);
+            }
+            if loading && af < 100.0 {
+                assert!(
+                    rel(xn, af * xc / 101.0) < 1e-9,
+                    "bonded branch at a = {af} x_c"
+                );
+                assert_eq!(s.beta, 1.0);
+            }
+            prev_xn = xn;
+            bond = BondState {
+                beta: s.beta,
+                ut: s.ut,
+            };
+            r = s.r_dry;
+        }
+        let off = snap_off.expect("snaps off");
+        let back = snap_back.expect("snaps back");
+        assert!((101.0..=101.5).contains(&off), "snap-off at a = {off} x_c");
+        assert!((5.0..=5.5).contains(&back), "snap-back at a = {back} x_c");
+    }
+
+    #[test]
+    fn degenerate_inputs_do_not_panic() {
+        let rcc = paper_rcc();
+        let law = InterfaceLaw {
+            mu: 0.5,
+            adhesion: Some(rcc),
+        };
+        let bond = BondState {
+            beta: 1.0,
+            ut: [1e-5, 0.0],
+        };
+        let cases: [(M3, V3, f64, f64); 6] = [
+            ([[0.0; 3]; 3], [0.0, 0.0, -1e-4], 1e-6, 1e-4),
+            ([[0.0; 3]; 3], [1e-5, 0.0, 1e-5], 1e-6, 1e-4),
+            (diag(1e-4, 1e-4, 1e-4), [1e-5, 0.0, 1e-5], 0.0, 1e-4),
+            (diag(1e-4, 1e-4, 1e-4), [1e-5, 0.0, 1e-5], 1e-6, 0.0),
+            (
+                diag(1e300, 1.0, 1e-300),
+                [1e300, -1e300, 1e-300],
+                1e300,
+                1e300,
+            ),
+            (diag(1e-4, 1e-4, 1e-4), [f64::NAN, 0.0, 1.0], 1e-6, 1e-4),
+        ];
+        for (w, xf, area, dt) in cases {
+            let p = PointProblem {
+                w_aa: w,
+                x_free: xf,
+                law: &law,
+                bond0: bond,
+                dt,
+                area,
+                rho: default_rho(w),
+            };
+            let s = solve_point(&p, [1.0, 2.0, 3.0], 1e-10, 30);
+            assert!(s.iterations <= 30);
+            let _ = solve_point(&p, [f64::NAN; 3], 1e-10, 0);
+        }
+        // W = 0 with an open gap and no adhesion: r = 0 at once.
+        let p = PointProblem {
+            w_aa: [[0.0; 3]; 3],
+            x_free: [0.0, 0.0, 1e-3],
+            law: &DRY,
+            bond0: BondState::default(),
+            dt: 1e-4,
+            area: 1e-6,
+            rho: 1.0,
+        };
+        let s = solve_point(&p, [0.0; 3], 1e-10, 10);
+        assert!(s.converged && s.r() == [0.0; 3]);
+    }
+}

@@ -1,0 +1,3 @@
+//! Frictional contact with recoverable adhesion: the local law (pure functions).
+
+pub mod law;

@@ -1,0 +1,27 @@
+//! adhesim: finite-element dynamics of soft bodies in frictional contact with recoverable
+//! adhesion (Raous-Cangémi-Cocou interface, bi-potential contact solver, NSCD θ-method).
+//!
+//! Data flows one way: a scenario file is parsed and validated into a [`problem::Problem`], a
+//! [`time::Stepper`] advances it step by step, and [`output::Observer`]s record what was
+//! computed. Physics never formats output and output never does physics.
+//!
+//! Units are SI throughout (m, kg, s, N, Pa).
+
+pub mod assembly;
+pub mod contact;
+pub mod element;
+pub mod linalg;
+pub mod material;
+pub mod mesh;
+pub mod output;
+pub mod problem;
+pub mod run;
+pub mod scenario;
+pub mod time;
+
+/// 3×3 matrix of f64 (deformation gradients, stresses).
+pub type Mat3 = nalgebra::Matrix3<f64>;
+/// 3-vector of f64 (positions, displacements, forces).
+pub type Vec3 = nalgebra::Vector3<f64>;
+/// 6×6 matrix of f64 (material tangents in Voigt notation).
+pub type Mat6 = nalgebra::Matrix6<f64>;

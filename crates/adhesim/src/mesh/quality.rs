@@ -1,0 +1,415 @@
+//! Mesh quality checks: scaled Jacobians, inverted cells, face-set orientation.
+//!
+//! Cells are indexed hexes first, then tets: cell `i < hexes.len()` is `hexes[i]`, cell
+//! `hexes.len() + j` is `tets[j]`.
+
+use super::{Face, Mesh, HEX_FACES, TET_FACES};
+use std::collections::HashMap;
+
+/// For each hex corner (VTK order): the corner and its neighbours along ξ, η, ζ, ordered so
+/// that the three edge vectors form a right-handed frame in a valid hex.
+const HEX_CORNER_FRAMES: [[usize; 4]; 8] = [
+    [0, 1, 3, 4],
+    [1, 2, 0, 5],
+    [2, 3, 1, 6],
+    [3, 0, 2, 7],
+    [4, 7, 5, 0],
+    [5, 4, 6, 1],
+    [6, 5, 7, 2],
+    [7, 6, 4, 3],
+];
+
+/// Natural coordinates (ξ, η, ζ) of the hex8 nodes (VTK order).
+const HEX_NATURAL: [[f64; 3]; 8] = [
+    [-1.0, -1.0, -1.0],
+    [1.0, -1.0, -1.0],
+    [1.0, 1.0, -1.0],
+    [-1.0, 1.0, -1.0],
+    [-1.0, -1.0, 1.0],
+    [1.0, -1.0, 1.0],
+    [1.0, 1.0, 1.0],
+    [-1.0, 1.0, 1.0],
+];
+
+/// Minimum scaled Jacobian of every cell (hexes first, then tets), dimensionless.
+///
+/// Hex: the minimum over the 8 corners of det[e₁, e₂, e₃] of the unit edge vectors leaving
+/// the corner along ξ, η, ζ (right-handed in a valid hex). Tet: det of the unit edge vectors
+/// x₁ − x₀, x₂ − x₀, x₃ − x₀ at node 0. The value is 1 for a cube (and for a tet with a
+/// right-angled corner at node 0, 1/√2 for a regular tet), ≤ 0 for an inverted or degenerate
+/// cell (a zero-length edge gives 0).
+pub fn cell_min_jacobian_ratio(mesh: &Mesh) -> Vec<f64> {
+    let hexes = mesh.hexes.iter().map(|h| {
+        HEX_CORNER_FRAMES
+            .iter()
+            .map(|f| corner_ratio(&mesh.nodes, h[f[0]], [h[f[1]], h[f[2]], h[f[3]]]))
+            .fold(f64::INFINITY, f64::min)
+    });
+    let tets = mesh
+        .tets
+        .iter()
+        .map(|t| corner_ratio(&mesh.nodes, t[0], [t[1], t[2], t[3]]));
+    hexes.chain(tets).collect()
+}
+
+/// Indices of the inverted or degenerate cells (hexes first, then tets): cells whose scaled
+/// Jacobian ratio is ≤ 0 or, for hexes, whose Jacobian determinant is ≤ 0 at one of the
+/// 2 × 2 × 2 Gauss points (±1/√3).
+pub fn inverted_cells(mesh: &Mesh) -> Vec<usize> {
+    let ratios = cell_min_jacobian_ratio(mesh);
+    let nh = mesh.hexes.len();
+    (0..ratios.len())
+        .filter(|&c| {
+            ratios[c] <= 0.0
+                || ratios[c].is_nan()
+                || (c < nh
+                    && hex_gauss_dets(&hex_coords(mesh, c))
+                        .iter()
+                        .any(|&d| d <= 0.0))
+        })
+        .collect()
+}
+
+/// Checks that every face of every face set is a boundary face of the mesh (a face of exactly
+/// one cell), listed with the same orientation as that cell's outward face, and that its
+/// normal points away from the cell's centroid.
+///
+/// # Errors
+/// A message naming the first offending face set and face.
+pub fn check_faces_outward(mesh: &Mesh) -> Result<(), String> {
+    let owners = face_owners(mesh);
+    for (name, faces) in &mesh.face_sets {
+        for face in faces {
+            check_face(mesh, &owners, face).map_err(|e| format!("face set '{name}': {e}"))?;
+        }
+    }
+    Ok(())
+}
+
+/// Scaled Jacobian of the frame of unit edge vectors from node `corner` to `ends`.
+fn corner_ratio(nodes: &[[f64; 3]], corner: usize, ends: [usize; 3]) -> f64 {
+    let o = nodes[corner];
+    let mut e = [[0.0; 3]; 3];
+    for (k, &end) in ends.iter().enumerate() {
+        let d = sub(nodes[end], o);
+        let len = norm(d);
+        if len == 0.0 || !len.is_finite() {
+            return 0.0;
+        }
+        e[k] = d.map(|x| x / len);
+    }
+    dot(e[0], cross(e[1], e[2]))
+}
+
+fn hex_coords(mesh: &Mesh, cell: usize) -> [[f64; 3]; 8] {
+    mesh.hexes[cell].map(|i| mesh.nodes[i])
+}
+
+/// Jacobian matrix ∂x/∂(ξ, η, ζ) (rows x, y, z) of a trilinear hex at natural point `xi`.
+fn hex_jacobian(x: &[[f64; 3]; 8], xi: [f64; 3]) -> [[f64; 3]; 3] {
+    let mut j = [[0.0; 3]; 3];
+    for (a, n) in HEX_NATURAL.iter().enumerate() {
+        let f = [1.0 + n[0] * xi[0], 1.0 + n[1] * xi[1], 1.0 + n[2] * xi[2]];
+        let grad = [
+            0.125 * n[0] * f[1] * f[2],
+            0.125 * n[1] * f[0] * f[2],
+            0.125 * n[2] * f[0] * f[1],
+        ];
+        for r in 0..3 {
+            for c in 0..3 {
+                j[r][c] += x[a][r] * grad[c];
+            }
+        }
+    }
+    j
+}
+
+/// Jacobian determinants of a hex at the 2 × 2 × 2 Gauss points (±1/√3) [m³ per unit
+/// natural volume]; each Gauss weight is 1.
+fn hex_gauss_dets(x: &[[f64; 3]; 8]) -> [f64; 8] {
+    let g = 1.0 / 3f64.sqrt();
+    HEX_NATURAL.map(|n| det3(hex_jacobian(x, n.map(|s| s * g))))
+}
+
+/// Volume of hex `cell` by 2 × 2 × 2 Gauss quadrature [m³].
+#[cfg(test)]
+pub(crate) fn hex_volume(mesh: &Mesh, cell: usize) -> f64 {
+    hex_gauss_dets(&hex_coords(mesh, cell)).iter().sum()
+}
+
+/// Every cell face keyed by its sorted node list: the owning cells and their outward faces.
+fn face_owners(mesh: &Mesh) -> HashMap<Vec<usize>, Vec<(usize, Face)>> {
+    let mut owners: HashMap<Vec<usize>, Vec<(usize, Face)>> = HashMap::new();
+    let mut add = |cell: usize, face: Face| {
+        let mut key = face.nodes().to_vec();
+        key.sort_unstable();
+        owners.entry(key).or_default().push((cell, face));
+    };
+    for (c, h) in mesh.hexes.iter().enumerate() {
+        for f in HEX_FACES {
+            add(c, Face::Quad(f.map(|k| h[k])));
+        }
+    }
+    let nh = mesh.hexes.len();
+    for (c, t) in mesh.tets.iter().enumerate() {
+        for f in TET_FACES {
+            add(nh + c, Face::Tri(f.map(|k| t[k])));
+        }
+    }
+    owners
+}
+
+fn check_face(
+    mesh: &Mesh,
+    owners: &HashMap<Vec<usize>, Vec<(usize, Face)>>,
+    face: &Face,
+) -> Result<(), String> {
+    let nodes = face.nodes();
+    if let Some(&bad) = nodes.iter().find(|&&i| i >= mesh.nodes.len()) {
+        return Err(format!("face {face:?} refers to missing node {bad}"));
+    }
+    let mut key = nodes.to_vec();
+    key.sort_unstable();
+    let (cell, outward) = match owners.get(&key).map(Vec::as_slice) {
+        None | Some([]) => return Err(format!("face {face:?} is not a face of any cell")),
+        Some([one]) => *one,
+        Some(many) => {
+            return Err(format!(
+                "face {face:?} is an interior face shared by {} cells",
+                many.len()
+            ))
+        }
+    };
+    if !same_cycle(nodes, outward.nodes()) {
+        return Err(format!(
+            "face {face:?} is oriented into cell {cell} (outward order {:?})",
+            outward.nodes()
+        ));
+    }
+    let normal = newell_normal(&mesh.nodes, nodes);
+    let away = sub(centroid(&mesh.nodes, nodes), cell_centroid(mesh, cell));
+    if dot(normal, away) <= 0.0 {
+        return Err(format!(
+            "face {face:?} has normal {normal:?} pointing into cell {cell}"
+        ));
+    }
+    Ok(())
+}
+
+/// True if `b` lists the same cyclic sequence as `a` (same orientation).
+fn same_cycle(a: &[usize], b: &[usize]) -> bool {
+    let n = a.len();
+    n == b.len() && (0..n).any(|shift| (0..n).all(|k| a[k] == b[(k + shift) % n]))
+}
+
+/// Newell's area-weighted normal of a polygon (right-hand rule over the node order).
+fn newell_normal(nodes: &[[f64; 3]], poly: &[usize]) -> [f64; 3] {
+    let mut n = [0.0; 3];
+    for k in 0..poly.len() {
+        let p = nodes[poly[k]];
+        let q = nodes[poly[(k + 1) % poly.len()]];
+        n[0] += (p[1] - q[1]) * (p[2] + q[2]);
+        n[1] += (p[2] - q[2]) * (p[0] + q[0]);
+        n[2] += (p[0] - q[0]) * (p[1] + q[1]);
+    }
+    n
+}
+
+fn centroid(nodes: &[[f64; 3]], ids: &[usize]) -> [f64; 3] {
+    let mut c = [0.0; 3];
+    for &i in ids {
+        for k in 0..3 {
+            c[k] += nodes[i][k] / ids.len() as f64;
+        }
+    }
+    c
+}
+
+fn cell_centroid(mesh: &Mesh, cell: usize) -> [f64; 3] {
+    let nh = mesh.hexes.len();
+    if cell < nh {
+        centroid(&mesh.nodes, &mesh.hexes[cell])
+    } else {
+        centroid(&mesh.nodes, &mesh.tets[cell - nh])
+    }
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+fn det3(m: [[f64; 3]; 3]) -> f64 {
+    dot(m[0], cross(m[1], m[2]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CUBE: [[f64; 3]; 8] = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [0.0, 1.0, 1.0],
+    ];
+
+    fn one_hex(nodes: [[f64; 3]; 8]) -> Mesh {
+        Mesh {
+            nodes: nodes.to_vec(),
+            hexes: vec![[0, 1, 2, 3, 4, 5, 6, 7]],
+            ..Mesh::default()
+        }
+    }
+
+    fn all_faces(mesh: &Mesh) -> Vec<Face> {
+        let h = mesh.hexes[0];
+        HEX_FACES
+            .iter()
+            .map(|f| Face::Quad(f.map(|k| h[k])))
+            .collect()
+    }
+
+    #[test]
+    fn cube_has_ratio_one_and_unit_volume() {
+        let m = one_hex(CUBE.map(|p| p.map(|x| 0.002 * x)));
+        assert!((cell_min_jacobian_ratio(&m)[0] - 1.0).abs() < 1e-14);
+        assert!((hex_volume(&m, 0) - 8e-9).abs() < 1e-22);
+        assert!(inverted_cells(&m).is_empty());
+    }
+
+    #[test]
+    fn sheared_hex_ratio_is_the_sine_of_its_angle() {
+        let s = 0.5;
+        let m = one_hex(CUBE.map(|p| [p[0] + s * p[1], p[1], p[2]]));
+        let expected = 1.0 / (1.0 + s * s).sqrt();
+        assert!((cell_min_jacobian_ratio(&m)[0] - expected).abs() < 1e-14);
+        assert!((hex_volume(&m, 0) - 1.0).abs() < 1e-14);
+    }
+
+    #[test]
+    fn frustum_volume_is_exact() {
+        // Square frustum of height 1 with sides 1 (bottom) and 2 (top): det J is quadratic in
+        // ζ, so the one-point rule would be wrong; 2 × 2 × 2 Gauss is exact: 7/3.
+        let m = one_hex(CUBE.map(|p| [p[0] * (1.0 + p[2]), p[1] * (1.0 + p[2]), p[2]]));
+        assert!((hex_volume(&m, 0) - 7.0 / 3.0).abs() < 1e-14);
+    }
+
+    #[test]
+    fn detects_swapped_nodes() {
+        let mut m = one_hex(CUBE);
+        m.hexes[0].swap(1, 3);
+        assert!(cell_min_jacobian_ratio(&m)[0] < 0.0);
+        assert_eq!(inverted_cells(&m), vec![0]);
+        let mut m = one_hex(CUBE);
+        m.hexes[0].swap(2, 6);
+        assert_eq!(inverted_cells(&m), vec![0]);
+    }
+
+    #[test]
+    fn detects_flattened_hex() {
+        let m = one_hex(CUBE.map(|p| [p[0], p[1], 0.0]));
+        assert_eq!(cell_min_jacobian_ratio(&m)[0], 0.0);
+        assert_eq!(inverted_cells(&m), vec![0]);
+        // Top face collapsed onto one edge: zero-length edges.
+        let mut nodes = CUBE;
+        nodes[6] = nodes[5];
+        nodes[7] = nodes[4];
+        assert_eq!(inverted_cells(&one_hex(nodes)), vec![0]);
+    }
+
+    #[test]
+    fn detects_corner_pushed_through_the_hex() {
+        // Pushing one corner through the opposite face inverts the hex near that corner.
+        let mut nodes = CUBE;
+        nodes[6] = [0.2, 0.2, 0.2];
+        let m = one_hex(nodes);
+        assert_eq!(inverted_cells(&m), vec![0]);
+    }
+
+    #[test]
+    fn tets_follow_hexes_and_use_node_zero() {
+        let mut m = one_hex(CUBE);
+        let base = m.nodes.len();
+        m.nodes.extend([
+            [3.0, 0.0, 0.0],
+            [4.0, 0.0, 0.0],
+            [3.0, 1.0, 0.0],
+            [3.0, 0.0, 1.0],
+        ]);
+        m.tets.push([base, base + 1, base + 2, base + 3]);
+        m.tets.push([base, base + 2, base + 1, base + 3]);
+        let r = cell_min_jacobian_ratio(&m);
+        assert_eq!(r.len(), 3);
+        assert!((r[1] - 1.0).abs() < 1e-14);
+        assert!((r[2] + 1.0).abs() < 1e-14);
+        assert_eq!(inverted_cells(&m), vec![2]);
+    }
+
+    #[test]
+    fn outward_faces_pass() {
+        let mut m = one_hex(CUBE);
+        let faces = all_faces(&m);
+        m.set_faces("all", faces);
+        assert_eq!(check_faces_outward(&m), Ok(()));
+    }
+
+    #[test]
+    fn reversed_face_is_reported_with_its_set() {
+        let mut m = one_hex(CUBE);
+        let mut faces = all_faces(&m);
+        let Face::Quad(q) = faces[2] else {
+            unreachable!()
+        };
+        faces[2] = Face::Quad([q[0], q[3], q[2], q[1]]);
+        m.set_faces("sides", faces);
+        let err = check_faces_outward(&m).unwrap_err();
+        assert!(
+            err.contains("'sides'") && err.contains("oriented into"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn interior_and_foreign_faces_are_reported() {
+        let mut nodes = CUBE.to_vec();
+        nodes.extend(CUBE[4..].iter().map(|p| [p[0], p[1], 2.0]));
+        let mut m = Mesh {
+            nodes,
+            hexes: vec![[0, 1, 2, 3, 4, 5, 6, 7], [4, 5, 6, 7, 8, 9, 10, 11]],
+            ..Mesh::default()
+        };
+        m.set_faces("middle", vec![Face::Quad([4, 5, 6, 7])]);
+        let err = check_faces_outward(&m).unwrap_err();
+        assert!(
+            err.contains("'middle'") && err.contains("interior"),
+            "{err}"
+        );
+        m.face_sets.clear();
+        m.set_faces("diagonal", vec![Face::Quad([0, 1, 6, 7])]);
+        let err = check_faces_outward(&m).unwrap_err();
+        assert!(
+            err.contains("'diagonal'") && err.contains("not a face"),
+            "{err}"
+        );
+    }
+}

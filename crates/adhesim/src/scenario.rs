@@ -1,0 +1,725 @@
+//! Scenario files (TOML) parsed and validated into a [`Problem`].
+//!
+//! Parsing (serde) rejects unknown keys and wrong types with the line and column; validation
+//! then checks values (positive moduli, time step, existing node sets, ...) and names the key
+//! that is wrong and what would be valid. The format is documented in `docs/scenario.md`.
+
+use crate::material::{self, Hyperelastic};
+use crate::mesh::generate::{self, FlatSide};
+use crate::mesh::Mesh;
+use crate::problem::{
+    Body, Dirichlet, NodalLoad, OutputSettings, Problem, Rotation, Table, TimeSettings, Track,
+};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// A scenario that could not be read or is invalid. The message names the file, the key or
+/// line, and what would be valid.
+#[derive(Debug, thiserror::Error)]
+#[error("{file}: {message}")]
+pub struct ScenarioError {
+    /// The scenario file.
+    pub file: PathBuf,
+    /// What is wrong and what would be valid.
+    pub message: String,
+}
+
+// ---------------------------------------------------------------------------------------
+// The file as written (serde).
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileScenario {
+    name: Option<String>,
+    time: FileTime,
+    #[serde(default)]
+    gravity: Option<[f64; 3]>,
+    #[serde(rename = "body")]
+    bodies: Vec<FileBody>,
+    #[serde(default, rename = "boundary")]
+    boundaries: Vec<FileBoundary>,
+    #[serde(default, rename = "load")]
+    loads: Vec<FileLoad>,
+    #[serde(default, rename = "track")]
+    tracks: Vec<FileTrack>,
+    #[serde(default)]
+    output: Option<FileOutput>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileTime {
+    t_end: f64,
+    dt: f64,
+    dt_min: Option<f64>,
+    theta: Option<f64>,
+    xi: Option<f64>,
+    mode: Option<String>,
+    newton_tol: Option<f64>,
+    max_newton: Option<usize>,
+    mass: Option<String>,
+    rayleigh_alpha: Option<f64>,
+    rayleigh_beta: Option<f64>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileBody {
+    name: String,
+    mesh: FileMesh,
+    material: FileMaterial,
+    density: f64,
+    #[serde(default)]
+    initial_velocity: Option<[f64; 3]>,
+    #[serde(default)]
+    plane_strain: bool,
+    #[serde(default)]
+    offset: Option<[f64; 3]>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields, tag = "generator", rename_all = "snake_case")]
+enum FileMesh {
+    Block {
+        size: [f64; 3],
+        divisions: [usize; 3],
+    },
+    Disk {
+        radius: f64,
+        thickness: f64,
+        n_quarter: usize,
+        n_radial: usize,
+    },
+    HalfDisk {
+        radius: f64,
+        thickness: f64,
+        n_quarter: usize,
+        n_radial: usize,
+        flat_side: String,
+    },
+    QuarterHemisphere {
+        radius: f64,
+        n: usize,
+    },
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileMaterial {
+    model: String,
+    g: Option<f64>,
+    young: Option<f64>,
+    poisson: Option<f64>,
+}
+
+#[derive(Deserialize, Debug, Clone)]
+#[serde(untagged)]
+enum FileTable {
+    Constant(f64),
+    Points(Vec<[f64; 2]>),
+}
+
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+struct FileComponents {
+    x: Option<FileTable>,
+    y: Option<FileTable>,
+    z: Option<FileTable>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileRotation {
+    axis: [f64; 3],
+    center: [f64; 3],
+    angular_velocity: Option<f64>,
+    start: Option<f64>,
+    angle: Option<Vec<[f64; 2]>>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileBoundary {
+    body: String,
+    set: String,
+    #[serde(default)]
+    fix: Vec<String>,
+    #[serde(default)]
+    displacement: Option<FileComponents>,
+    #[serde(default)]
+    rotation: Option<FileRotation>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileLoad {
+    body: String,
+    set: String,
+    force: FileComponents,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileTrack {
+    name: String,
+    body: String,
+    point: Option<[f64; 3]>,
+    node: Option<usize>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileOutput {
+    frame_interval: Option<f64>,
+}
+
+// ---------------------------------------------------------------------------------------
+// Validation.
+
+struct Ctx<'a> {
+    file: &'a Path,
+}
+
+impl Ctx<'_> {
+    fn err(&self, message: impl Into<String>) -> ScenarioError {
+        ScenarioError {
+            file: self.file.to_path_buf(),
+            message: message.into(),
+        }
+    }
+    fn positive(&self, key: &str, v: f64) -> Result<f64, ScenarioError> {
+        if v.is_finite() && v > 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(format!("`{key}` must be a positive finite number, got {v}")))
+        }
+    }
+    fn finite(&self, key: &str, v: f64) -> Result<f64, ScenarioError> {
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(self.err(format!("`{key}` must be a finite number, got {v}")))
+        }
+    }
+    fn finite3(&self, key: &str, v: [f64; 3]) -> Result<[f64; 3], ScenarioError> {
+        for (k, c) in v.iter().enumerate() {
+            self.finite(&format!("{key}[{k}]"), *c)?;
+        }
+        Ok(v)
+    }
+    fn count(&self, key: &str, n: usize, max: usize) -> Result<usize, ScenarioError> {
+        if (1..=max).contains(&n) {
+            Ok(n)
+        } else {
+            Err(self.err(format!(
+                "`{key}` must be a whole number from 1 to {max}, got {n}"
+            )))
+        }
+    }
+}
+
+/// Reads and validates a scenario file.
+pub fn load(path: &Path) -> Result<Problem, ScenarioError> {
+    let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
+        file: path.to_path_buf(),
+        message: format!("cannot read the scenario file: {e}"),
+    })?;
+    parse(&text, path)
+}
+
+/// Parses and validates scenario text; `path` names the file in errors and sets the default
+/// run name.
+pub fn parse(text: &str, path: &Path) -> Result<Problem, ScenarioError> {
+    let ctx = Ctx { file: path };
+    let raw: FileScenario = toml::from_str(text).map_err(|e| {
+        ctx.err(format!(
+            "{}\n(see docs/scenario.md for the valid keys and types)",
+            e.to_string().trim_end()
+        ))
+    })?;
+    validate(raw, &ctx)
+}
+
+fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
+    let name = raw.name.clone().unwrap_or_else(|| {
+        ctx.file
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "run".into())
+    });
+    if name.is_empty() || name.contains(['/', '\\']) {
+        return Err(ctx.err(format!(
+            "`name` must be a non-empty file stem without slashes, got {name:?}"
+        )));
+    }
+    let time = validate_time(&raw.time, ctx)?;
+    if raw.bodies.is_empty() {
+        return Err(ctx.err("at least one [[body]] is needed"));
+    }
+    let mut bodies = Vec::new();
+    let mut body_index: BTreeMap<String, usize> = BTreeMap::new();
+    let mut dirichlet = Vec::new();
+    for (i, b) in raw.bodies.iter().enumerate() {
+        let key = format!("body[{i}]");
+        if body_index.insert(b.name.clone(), i).is_some() {
+            return Err(ctx.err(format!(
+                "`{key}.name`: the body name {:?} is used twice; names must be unique",
+                b.name
+            )));
+        }
+        let mut mesh = build_mesh(&b.mesh, &format!("{key}.mesh"), ctx)?;
+        if let Some(off) = b.offset {
+            mesh.translate(ctx.finite3(&format!("{key}.offset"), off)?);
+        }
+        let material = build_material(&b.material, &format!("{key}.material"), ctx)?;
+        let density = ctx.positive(&format!("{key}.density"), b.density)?;
+        let initial_velocity = ctx.finite3(
+            &format!("{key}.initial_velocity"),
+            b.initial_velocity.unwrap_or([0.0; 3]),
+        )?;
+        bodies.push(Body {
+            name: b.name.clone(),
+            mesh,
+            material,
+            density,
+            initial_velocity,
+        });
+    }
+    let offsets = {
+        let mut o = Vec::new();
+        let mut n = 0;
+        for b in &bodies {
+            o.push(n);
+            n += b.mesh.num_nodes();
+        }
+        o
+    };
+    // Plane strain: out-of-plane displacement fixed on every node of the body.
+    for (i, b) in raw.bodies.iter().enumerate() {
+        if b.plane_strain {
+            let nodes = (0..bodies[i].mesh.num_nodes())
+                .map(|n| n + offsets[i])
+                .collect();
+            dirichlet.push(Dirichlet {
+                nodes,
+                components: [false, false, true],
+                translation: [
+                    Table::constant(0.0),
+                    Table::constant(0.0),
+                    Table::constant(0.0),
+                ],
+                rotation: None,
+            });
+        }
+    }
+    let find_set =
+        |key: &str, body: &str, set: &str| -> Result<Vec<usize>, ScenarioError> {
+            let bi = *body_index.get(body).ok_or_else(|| {
+                ctx.err(format!(
+                    "`{key}.body` = {body:?} is not a body of this scenario; bodies are: {}",
+                    body_index.keys().cloned().collect::<Vec<_>>().join(", ")
+                ))
+            })?;
+            let mesh = &bodies[bi].mesh;
+            let nodes =
+                mesh.node_sets.get(set).ok_or_else(|| {
+                    ctx.err(format!(
+                "`{key}.set` = {set:?} is not a node set of body {body:?}; its sets are: {}",
+                mesh.node_sets.keys().cloned().collect::<Vec<_>>().join(", ")
+            ))
+                })?;
+            if nodes.is_empty() {
+                return Err(ctx.err(format!("`{key}.set` = {set:?} of body {body:?} is empty")));
+            }
+            Ok(nodes.iter().map(|n| n + offsets[bi]).collect())
+        };
+    for (i, bc) in raw.boundaries.iter().enumerate() {
+        let key = format!("boundary[{i}]");
+        let nodes = find_set(&key, &bc.body, &bc.set)?;
+        let mut components = [false; 3];
+        let zero = || {
+            [
+                Table::constant(0.0),
+                Table::constant(0.0),
+                Table::constant(0.0),
+            ]
+        };
+        let mut translation = zero();
+        for c in &bc.fix {
+            let k = axis_index(c).ok_or_else(|| {
+                ctx.err(format!(
+                    "`{key}.fix` holds {c:?}; valid entries are \"x\", \"y\", \"z\""
+                ))
+            })?;
+            components[k] = true;
+        }
+        if let Some(d) = &bc.displacement {
+            for (k, (cname, t)) in [("x", &d.x), ("y", &d.y), ("z", &d.z)]
+                .into_iter()
+                .enumerate()
+            {
+                if let Some(t) = t {
+                    if components[k] {
+                        return Err(ctx.err(format!("`{key}`: component {cname} is both in `fix` and in `displacement`; give it once")));
+                    }
+                    components[k] = true;
+                    translation[k] = build_table(t, &format!("{key}.displacement.{cname}"), ctx)?;
+                }
+            }
+        }
+        let rotation = match &bc.rotation {
+            None => None,
+            Some(r) => {
+                components = [true; 3];
+                Some(build_rotation(r, &format!("{key}.rotation"), ctx)?)
+            }
+        };
+        if components == [false; 3] {
+            return Err(ctx.err(format!(
+                "`{key}` prescribes nothing: give `fix`, `displacement` or `rotation`"
+            )));
+        }
+        dirichlet.push(Dirichlet {
+            nodes,
+            components,
+            translation,
+            rotation,
+        });
+    }
+    let mut loads = Vec::new();
+    for (i, l) in raw.loads.iter().enumerate() {
+        let key = format!("load[{i}]");
+        let nodes = find_set(&key, &l.body, &l.set)?;
+        let mut total_force = [
+            Table::constant(0.0),
+            Table::constant(0.0),
+            Table::constant(0.0),
+        ];
+        for (k, (cname, t)) in [("x", &l.force.x), ("y", &l.force.y), ("z", &l.force.z)]
+            .into_iter()
+            .enumerate()
+        {
+            if let Some(t) = t {
+                total_force[k] = build_table(t, &format!("{key}.force.{cname}"), ctx)?;
+            }
+        }
+        loads.push(NodalLoad { nodes, total_force });
+    }
+    let mut tracks = Vec::new();
+    for (i, t) in raw.tracks.iter().enumerate() {
+        let key = format!("track[{i}]");
+        if t.name.is_empty() || t.name.contains([',', '"', '\n']) {
+            return Err(ctx.err(format!(
+                "`{key}.name` must be non-empty and hold no comma or quote, got {:?}",
+                t.name
+            )));
+        }
+        let bi = *body_index.get(&t.body).ok_or_else(|| {
+            ctx.err(format!(
+                "`{key}.body` = {:?} is not a body of this scenario",
+                t.body
+            ))
+        })?;
+        let mesh = &bodies[bi].mesh;
+        let local = match (t.point, t.node) {
+            (Some(p), None) => nearest_node(mesh, ctx.finite3(&format!("{key}.point"), p)?),
+            (None, Some(n)) if n < mesh.num_nodes() => n,
+            (None, Some(n)) => {
+                return Err(ctx.err(format!("`{key}.node` = {n} is out of range: body {:?} has {} nodes (0 to {})", t.body, mesh.num_nodes(), mesh.num_nodes() - 1)))
+            }
+            _ => return Err(ctx.err(format!("`{key}` needs exactly one of `point` (a position [m]; the nearest node is tracked) or `node` (an index)"))),
+        };
+        tracks.push(Track {
+            name: t.name.clone(),
+            node: local + offsets[bi],
+        });
+    }
+    let gravity = ctx.finite3("gravity", raw.gravity.unwrap_or([0.0; 3]))?;
+    let frame_interval = match raw.output.as_ref().and_then(|o| o.frame_interval) {
+        None => 0.0,
+        Some(v) if v.is_finite() && v >= 0.0 => v,
+        Some(v) => {
+            return Err(ctx.err(format!(
+                "`output.frame_interval` must be ≥ 0 (0 = every step), got {v}"
+            )))
+        }
+    };
+    Ok(Problem {
+        name,
+        bodies,
+        dirichlet,
+        loads,
+        gravity,
+        time,
+        tracks,
+        output: OutputSettings { frame_interval },
+    })
+}
+
+fn axis_index(c: &str) -> Option<usize> {
+    match c {
+        "x" => Some(0),
+        "y" => Some(1),
+        "z" => Some(2),
+        _ => None,
+    }
+}
+
+fn nearest_node(mesh: &Mesh, p: [f64; 3]) -> usize {
+    let d2 = |x: &[f64; 3]| (0..3).map(|k| (x[k] - p[k]).powi(2)).sum::<f64>();
+    (0..mesh.num_nodes())
+        .min_by(|&a, &b| d2(&mesh.nodes[a]).total_cmp(&d2(&mesh.nodes[b])))
+        .unwrap_or(0)
+}
+
+fn validate_time(t: &FileTime, ctx: &Ctx) -> Result<TimeSettings, ScenarioError> {
+    let d = TimeSettings::default();
+    let t_end = ctx.positive("time.t_end", t.t_end)?;
+    let dt = ctx.positive("time.dt", t.dt)?;
+    let dt_min = ctx.positive(
+        "time.dt_min",
+        t.dt_min.unwrap_or((dt * 1e-6).min(d.dt_min.max(dt * 1e-9))),
+    )?;
+    if dt_min > dt {
+        return Err(ctx.err(format!(
+            "`time.dt_min` ({dt_min}) must not exceed `time.dt` ({dt})"
+        )));
+    }
+    let theta = t.theta.unwrap_or(d.theta);
+    if !(theta > 0.0 && theta <= 1.0) {
+        return Err(ctx.err(format!(
+            "`time.theta` must be in (0, 1] (½ = trapezoidal, 1 = backward Euler), got {theta}"
+        )));
+    }
+    let xi = t.xi.unwrap_or(d.xi);
+    if !(0.0..=1.0).contains(&xi) {
+        return Err(ctx.err(format!("`time.xi` must be in [0, 1], got {xi}")));
+    }
+    let quasi_static = match t.mode.as_deref() {
+        None | Some("dynamic") => false,
+        Some("quasi-static") => true,
+        Some(m) => {
+            return Err(ctx.err(format!(
+                "`time.mode` = {m:?}; valid values are \"dynamic\" and \"quasi-static\""
+            )))
+        }
+    };
+    let lumped_mass = match t.mass.as_deref() {
+        None | Some("consistent") => false,
+        Some("lumped") => true,
+        Some(m) => {
+            return Err(ctx.err(format!(
+                "`time.mass` = {m:?}; valid values are \"consistent\" and \"lumped\""
+            )))
+        }
+    };
+    let newton_tol = t.newton_tol.unwrap_or(d.newton_tol);
+    if !(newton_tol > 0.0 && newton_tol < 1.0) {
+        return Err(ctx.err(format!(
+            "`time.newton_tol` must be in (0, 1), got {newton_tol}"
+        )));
+    }
+    let max_newton = ctx.count(
+        "time.max_newton",
+        t.max_newton.unwrap_or(d.max_newton),
+        1000,
+    )?;
+    let alpha = t.rayleigh_alpha.unwrap_or(0.0);
+    let beta = t.rayleigh_beta.unwrap_or(0.0);
+    for (k, v) in [("time.rayleigh_alpha", alpha), ("time.rayleigh_beta", beta)] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(ctx.err(format!("`{k}` must be ≥ 0, got {v}")));
+        }
+    }
+    Ok(TimeSettings {
+        t_end,
+        dt,
+        dt_min,
+        theta,
+        xi,
+        quasi_static,
+        newton_tol,
+        max_newton,
+        lumped_mass,
+        rayleigh: (alpha, beta),
+    })
+}
+
+/// Largest element count per direction a generator accepts (guards against typos that
+/// would exhaust memory).
+const MAX_DIVISIONS: usize = 2000;
+
+fn build_mesh(m: &FileMesh, key: &str, ctx: &Ctx) -> Result<Mesh, ScenarioError> {
+    Ok(match m {
+        FileMesh::Block { size, divisions } => {
+            for k in 0..3 {
+                ctx.positive(&format!("{key}.size[{k}]"), size[k])?;
+                ctx.count(
+                    &format!("{key}.divisions[{k}]"),
+                    divisions[k],
+                    MAX_DIVISIONS,
+                )?;
+            }
+            if divisions.iter().product::<usize>() > 20_000_000 {
+                return Err(ctx.err(format!(
+                    "`{key}.divisions` asks for more than 20 million elements"
+                )));
+            }
+            generate::block(*size, *divisions)
+        }
+        FileMesh::Disk {
+            radius,
+            thickness,
+            n_quarter,
+            n_radial,
+        } => {
+            ctx.positive(&format!("{key}.radius"), *radius)?;
+            ctx.positive(&format!("{key}.thickness"), *thickness)?;
+            ctx.count(&format!("{key}.n_quarter"), *n_quarter, MAX_DIVISIONS)?;
+            ctx.count(&format!("{key}.n_radial"), *n_radial, MAX_DIVISIONS)?;
+            generate::disk(*radius, *thickness, *n_quarter, *n_radial)
+        }
+        FileMesh::HalfDisk {
+            radius,
+            thickness,
+            n_quarter,
+            n_radial,
+            flat_side,
+        } => {
+            ctx.positive(&format!("{key}.radius"), *radius)?;
+            ctx.positive(&format!("{key}.thickness"), *thickness)?;
+            ctx.count(&format!("{key}.n_quarter"), *n_quarter, MAX_DIVISIONS)?;
+            ctx.count(&format!("{key}.n_radial"), *n_radial, MAX_DIVISIONS)?;
+            let side = match flat_side.as_str() {
+                "top" => FlatSide::Top,
+                "bottom" => FlatSide::Bottom,
+                s => {
+                    return Err(ctx.err(format!(
+                        "`{key}.flat_side` = {s:?}; valid values are \"top\" and \"bottom\""
+                    )))
+                }
+            };
+            generate::half_disk(*radius, *thickness, *n_quarter, *n_radial, side)
+        }
+        FileMesh::QuarterHemisphere { radius, n } => {
+            ctx.positive(&format!("{key}.radius"), *radius)?;
+            ctx.count(&format!("{key}.n"), *n, MAX_DIVISIONS)?;
+            generate::quarter_hemisphere(*radius, *n)
+        }
+    })
+}
+
+fn build_material(
+    m: &FileMaterial,
+    key: &str,
+    ctx: &Ctx,
+) -> Result<Arc<dyn Hyperelastic>, ScenarioError> {
+    let young_poisson = || -> Result<(f64, f64), ScenarioError> {
+        let e = m.young.ok_or_else(|| {
+            ctx.err(format!(
+                "`{key}` with model {:?} needs `young` [Pa] and `poisson`",
+                m.model
+            ))
+        })?;
+        let nu = m.poisson.ok_or_else(|| {
+            ctx.err(format!(
+                "`{key}` with model {:?} needs `young` [Pa] and `poisson`",
+                m.model
+            ))
+        })?;
+        ctx.positive(&format!("{key}.young"), e)?;
+        if !(nu > -1.0 && nu < 0.5) {
+            return Err(ctx.err(format!("`{key}.poisson` must be in (−1, 0.5), got {nu}")));
+        }
+        if m.g.is_some() {
+            return Err(ctx.err(format!(
+                "`{key}.g` is not used by model {:?}; give `young` and `poisson`",
+                m.model
+            )));
+        }
+        Ok((e, nu))
+    };
+    Ok(match m.model.as_str() {
+        "blatz-ko" => {
+            if m.young.is_some() || m.poisson.is_some() {
+                return Err(ctx.err(format!("`{key}`: the Blatz-Ko model takes only `g` (shear modulus [Pa]); its Poisson ratio is ¼")));
+            }
+            let g = m.g.ok_or_else(|| ctx.err(format!("`{key}` with model \"blatz-ko\" needs `g` (shear modulus [Pa])")))?;
+            Arc::new(material::BlatzKo { g: ctx.positive(&format!("{key}.g"), g)? })
+        }
+        "neo-hookean" => {
+            let (e, nu) = young_poisson()?;
+            Arc::new(material::NeoHookean::from_young_poisson(e, nu))
+        }
+        "saint-venant-kirchhoff" => {
+            let (e, nu) = young_poisson()?;
+            Arc::new(material::SaintVenantKirchhoff::from_young_poisson(e, nu))
+        }
+        "linear-elastic" => {
+            let (e, nu) = young_poisson()?;
+            Arc::new(material::LinearElastic::from_young_poisson(e, nu))
+        }
+        other => {
+            return Err(ctx.err(format!(
+                "`{key}.model` = {other:?}; valid models are \"blatz-ko\", \"neo-hookean\", \"saint-venant-kirchhoff\", \"linear-elastic\""
+            )))
+        }
+    })
+}
+
+fn build_table(t: &FileTable, key: &str, ctx: &Ctx) -> Result<Table, ScenarioError> {
+    match t {
+        FileTable::Constant(v) => Ok(Table::constant(ctx.finite(key, *v)?)),
+        FileTable::Points(p) => {
+            if p.is_empty() {
+                return Err(ctx.err(format!(
+                    "`{key}` is an empty table; give a number or [[t, value], ...]"
+                )));
+            }
+            for (i, [t, v]) in p.iter().enumerate() {
+                ctx.finite(&format!("{key}[{i}]"), *t)?;
+                ctx.finite(&format!("{key}[{i}]"), *v)?;
+                if i > 0 && *t <= p[i - 1][0] {
+                    return Err(ctx.err(format!("`{key}`: times must increase strictly, but entry {i} has t = {t} after t = {}", p[i - 1][0])));
+                }
+            }
+            Ok(Table {
+                t: p.iter().map(|e| e[0]).collect(),
+                v: p.iter().map(|e| e[1]).collect(),
+            })
+        }
+    }
+}
+
+fn build_rotation(r: &FileRotation, key: &str, ctx: &Ctx) -> Result<Rotation, ScenarioError> {
+    let axis = ctx.finite3(&format!("{key}.axis"), r.axis)?;
+    let len = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+    if !(len > 0.0) {
+        return Err(ctx.err(format!("`{key}.axis` must be a non-zero vector")));
+    }
+    let center = ctx.finite3(&format!("{key}.center"), r.center)?;
+    let angle = match (&r.angle, r.angular_velocity) {
+        (Some(a), None) => {
+            if r.start.is_some() {
+                return Err(ctx.err(format!("`{key}.start` goes with `angular_velocity`, not with `angle`")));
+            }
+            build_table(&FileTable::Points(a.clone()), &format!("{key}.angle"), ctx)?
+        }
+        (None, Some(w)) => {
+            let w = ctx.finite(&format!("{key}.angular_velocity"), w)?;
+            let start = ctx.finite(&format!("{key}.start"), r.start.unwrap_or(0.0))?;
+            // θ(t) = ω (t − start) for t > start: a two-point table extrapolated linearly
+            // would hold its end value, so give it a far end point.
+            let far = start + 1e6;
+            Table { t: vec![start, far], v: vec![0.0, w * (far - start)] }
+        }
+        _ => return Err(ctx.err(format!("`{key}` needs exactly one of `angular_velocity` [rad/s] (with optional `start` [s]) or `angle` (a table [[t, rad], ...])"))),
+    };
+    Ok(Rotation {
+        center,
+        axis: axis.map(|a| a / len),
+        angle,
+    })
+}

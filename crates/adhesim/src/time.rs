@@ -1,0 +1,481 @@
+//! One NSCD θ-method step (model.md §3) with its Newton loop and Δt cut-back.
+//!
+//! Over [t, t+Δt] with known u₀, v₀ and unknown u₁:
+//!   v₁ = (u₁ − u₀)/(θΔt) − (1−θ)/θ · v₀
+//!   G(u₁) = M (u₁ − u₀ − Δt v₀)/(θΔt²) − (1−ξ)(F_ext⁰ − F_int(u₀) − A v₀)
+//!           − ξ (F_ext¹ − F_int(u₁) − A v₁) − R₁
+//!   K̄ = ξ K + ξ/(θΔt) A + M/(θΔt²)
+//! The quasi-static mode drops M and A: G = F_int(u₁) − F_ext¹ − R₁, K̄ = K.
+
+use crate::assembly::{BadElement, Discretisation};
+use crate::linalg::{LinalgError, SparseCholesky};
+use crate::problem::Problem;
+use std::sync::Arc;
+
+/// Why a run could not be set up.
+#[derive(Debug, thiserror::Error)]
+pub enum SetupError {
+    /// Degenerate or inverted elements in the reference meshes.
+    #[error("{} degenerate or inverted element(s) in the reference mesh: {}", .0.len(), describe_bad(.0))]
+    BadElements(Vec<BadElement>),
+    /// The linear-algebra setup failed.
+    #[error(transparent)]
+    Linalg(#[from] LinalgError),
+}
+
+fn describe_bad(bad: &[BadElement]) -> String {
+    let mut s: Vec<String> = bad
+        .iter()
+        .take(10)
+        .map(|b| format!("body {} cell {} (det J = {:.3e})", b.body, b.cell, b.det))
+        .collect();
+    if bad.len() > 10 {
+        s.push(format!("and {} more", bad.len() - 10));
+    }
+    s.join(", ")
+}
+
+/// Why a step could not be completed even at the smallest time step.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("the step from t = {t:.6e} s could not be completed: Δt fell below its minimum {dt_min:.3e} s; last failure: {reason}")]
+pub struct StepError {
+    /// Time at the start of the failed step [s].
+    pub t: f64,
+    /// The smallest allowed step [s].
+    pub dt_min: f64,
+    /// What went wrong at the smallest step tried.
+    pub reason: String,
+}
+
+/// What one committed step did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StepReport {
+    /// Step number (1-based).
+    pub step: usize,
+    /// Time at the end of the step [s].
+    pub t: f64,
+    /// Step size used [s].
+    pub dt: f64,
+    /// Newton iterations of the successful attempt.
+    pub newton_iterations: usize,
+    /// Attempts discarded (Δt halved) before this step succeeded.
+    pub cutbacks: usize,
+    /// Final relative residual.
+    pub residual: f64,
+    /// Kinetic energy ½ vᵀMv [J].
+    pub kinetic: f64,
+    /// Strain energy [J].
+    pub internal: f64,
+    /// Work done on the bodies since t = 0 by loads, gravity and supports [J].
+    pub external_work: f64,
+}
+
+/// The state of the bodies.
+#[derive(Clone, Debug)]
+pub struct State {
+    /// Time [s].
+    pub t: f64,
+    /// Nodal displacements [m], 3 per node.
+    pub u: Vec<f64>,
+    /// Nodal velocities [m/s], 3 per node.
+    pub v: Vec<f64>,
+    /// Number of committed steps.
+    pub step: usize,
+}
+
+/// Advances a [`Problem`] in time.
+pub struct Stepper {
+    /// The problem being solved.
+    pub problem: Arc<Problem>,
+    /// Its discretisation.
+    pub disc: Discretisation,
+    /// Committed state.
+    pub state: State,
+    mass: Vec<f64>,
+    damping: Option<Vec<f64>>,
+    gravity_force: Vec<f64>,
+    chol: SparseCholesky,
+    constrained: Vec<bool>,
+    zero_positions: Vec<usize>,
+    dt: f64,
+    good_steps_since_cut: usize,
+    f_ext0: Vec<f64>,
+    f_int0: Vec<f64>,
+    external_work: f64,
+    last_internal: f64,
+}
+
+struct Attempt {
+    u: Vec<f64>,
+    v: Vec<f64>,
+    f_ext1: Vec<f64>,
+    f_int1: Vec<f64>,
+    iterations: usize,
+    residual: f64,
+    internal: f64,
+    work: f64,
+}
+
+impl Stepper {
+    /// Discretises the problem and analyses the system matrix.
+    pub fn new(problem: Arc<Problem>) -> Result<Self, SetupError> {
+        let bodies: Vec<_> = problem
+            .bodies
+            .iter()
+            .map(|b| (&b.mesh, b.material.clone()))
+            .collect();
+        let disc = Discretisation::new(&bodies).map_err(SetupError::BadElements)?;
+        let density: Vec<f64> = problem.bodies.iter().map(|b| b.density).collect();
+        let mass = disc.mass(&density, problem.time.lumped_mass);
+        let n = disc.num_dofs();
+        let (am, bk) = problem.time.rayleigh;
+        let damping = if am != 0.0 || bk != 0.0 {
+            let k0 = disc.assemble(&vec![0.0; n], true).tangent;
+            Some(mass.iter().zip(&k0).map(|(m, k)| am * m + bk * k).collect())
+        } else {
+            None
+        };
+        let mut g = vec![0.0; n];
+        for i in 0..disc.num_nodes {
+            g[3 * i..3 * i + 3].copy_from_slice(&problem.gravity);
+        }
+        let mut gravity_force = vec![0.0; n];
+        disc.pattern.symmetric_matvec(&mass, &g, &mut gravity_force);
+        let mut constrained = vec![false; n];
+        for d in &problem.dirichlet {
+            for &node in &d.nodes {
+                for k in 0..3 {
+                    if d.components[k] {
+                        constrained[3 * node + k] = true;
+                    }
+                }
+            }
+        }
+        let p = &disc.pattern;
+        let mut zero_positions = Vec::new();
+        for j in 0..p.dim() {
+            for q in p.col_ptr[j]..p.col_ptr[j + 1] {
+                let i = p.row_idx[q];
+                if i != j && (constrained[i] || constrained[j]) {
+                    zero_positions.push(q);
+                }
+            }
+        }
+        let chol = SparseCholesky::analyse(p, 0)?;
+        let mut v0 = vec![0.0; n];
+        let offsets = problem.node_offsets();
+        for (b, off) in problem.bodies.iter().zip(offsets) {
+            for i in 0..b.mesh.num_nodes() {
+                v0[3 * (off + i)..3 * (off + i) + 3].copy_from_slice(&b.initial_velocity);
+            }
+        }
+        let state = State {
+            t: 0.0,
+            u: vec![0.0; n],
+            v: v0,
+            step: 0,
+        };
+        let mut s = Stepper {
+            dt: problem.time.dt,
+            problem,
+            disc,
+            state,
+            mass,
+            damping,
+            gravity_force,
+            chol,
+            constrained,
+            zero_positions,
+            good_steps_since_cut: 0,
+            f_ext0: vec![0.0; n],
+            f_int0: vec![0.0; n],
+            external_work: 0.0,
+            last_internal: 0.0,
+        };
+        s.apply_dirichlet_to_state();
+        s.f_ext0 = s.external_force(0.0);
+        let a = s.disc.assemble(&s.state.u, false);
+        s.f_int0 = a.force;
+        s.last_internal = a.energy;
+        Ok(s)
+    }
+
+    fn apply_dirichlet_to_state(&mut self) {
+        let u = &mut self.state.u;
+        for d in &self.problem.dirichlet {
+            for &node in &d.nodes {
+                let x = self.disc.reference[node];
+                let ud = d.displacement(x, 0.0);
+                for k in 0..3 {
+                    if d.components[k] {
+                        u[3 * node + k] = ud[k];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Loads and gravity at time `t` [N].
+    fn external_force(&self, t: f64) -> Vec<f64> {
+        let mut f = self.gravity_force.clone();
+        for load in &self.problem.loads {
+            let share = 1.0 / load.nodes.len().max(1) as f64;
+            for k in 0..3 {
+                let fk = load.total_force[k].at(t) * share;
+                for &node in &load.nodes {
+                    f[3 * node + k] += fk;
+                }
+            }
+        }
+        f
+    }
+
+    /// True when the end time has been reached.
+    pub fn finished(&self) -> bool {
+        self.state.t >= self.problem.time.t_end * (1.0 - 1e-12)
+    }
+
+    /// The step size the next step will try [s].
+    pub fn next_dt(&self) -> f64 {
+        self.dt.min(self.problem.time.t_end - self.state.t)
+    }
+
+    /// Kinetic energy ½ vᵀMv of a velocity field [J].
+    pub fn kinetic_energy(&self, v: &[f64]) -> f64 {
+        let mut mv = vec![0.0; v.len()];
+        self.disc.pattern.symmetric_matvec(&self.mass, v, &mut mv);
+        0.5 * v.iter().zip(&mv).map(|(a, b)| a * b).sum::<f64>()
+    }
+
+    /// Advances one step, halving Δt on failure down to dt_min.
+    pub fn step(&mut self) -> Result<StepReport, StepError> {
+        let ts = self.problem.time.clone();
+        let mut cutbacks = 0;
+        loop {
+            let remaining = ts.t_end - self.state.t;
+            let mut dt = self.dt.min(remaining);
+            // Avoid a sliver of a last step.
+            if remaining - dt < 1e-3 * dt {
+                dt = remaining;
+            }
+            match self.attempt(dt) {
+                Ok(a) => {
+                    self.commit(a.u, a.v, dt);
+                    self.external_work += a.work;
+                    self.last_internal = a.internal;
+                    if cutbacks > 0 {
+                        self.good_steps_since_cut = 0;
+                    } else {
+                        self.good_steps_since_cut += 1;
+                        if self.good_steps_since_cut >= 2 && self.dt < ts.dt {
+                            self.dt = (self.dt * 2.0).min(ts.dt);
+                            self.good_steps_since_cut = 0;
+                        }
+                    }
+                    self.f_ext0 = a.f_ext1;
+                    self.f_int0 = a.f_int1;
+                    let kinetic = if ts.quasi_static {
+                        0.0
+                    } else {
+                        self.kinetic_energy(&self.state.v)
+                    };
+                    return Ok(StepReport {
+                        step: self.state.step,
+                        t: self.state.t,
+                        dt,
+                        newton_iterations: a.iterations,
+                        cutbacks,
+                        residual: a.residual,
+                        kinetic,
+                        internal: a.internal,
+                        external_work: self.external_work,
+                    });
+                }
+                Err(reason) => {
+                    if dt * 0.5 < ts.dt_min {
+                        return Err(StepError {
+                            t: self.state.t,
+                            dt_min: ts.dt_min,
+                            reason,
+                        });
+                    }
+                    self.dt = dt * 0.5;
+                    cutbacks += 1;
+                }
+            }
+        }
+    }
+
+    fn commit(&mut self, u: Vec<f64>, v: Vec<f64>, dt: f64) {
+        self.state.u = u;
+        self.state.v = v;
+        self.state.t += dt;
+        if (self.problem.time.t_end - self.state.t).abs() < 1e-12 * self.problem.time.t_end {
+            self.state.t = self.problem.time.t_end;
+        }
+        self.state.step += 1;
+    }
+
+    /// One Newton solve over [t, t+dt]; Err with the reason on failure.
+    fn attempt(&mut self, dt: f64) -> Result<Attempt, String> {
+        let ts = &self.problem.time;
+        let (theta, xi, qs) = (ts.theta, ts.xi, ts.quasi_static);
+        let t1 = self.state.t + dt;
+        let n = self.disc.num_dofs();
+        let u0 = &self.state.u;
+        let v0 = &self.state.v;
+        let f_ext1 = self.external_force(t1);
+        // Predictor: constant velocity for dynamics, last state for quasi-static.
+        let mut u: Vec<f64> = if qs {
+            u0.clone()
+        } else {
+            (0..n).map(|i| u0[i] + dt * v0[i]).collect()
+        };
+        for d in &self.problem.dirichlet {
+            for &node in &d.nodes {
+                let ud = d.displacement(self.disc.reference[node], t1);
+                for k in 0..3 {
+                    if d.components[k] {
+                        u[3 * node + k] = ud[k];
+                    }
+                }
+            }
+        }
+        // Terms fixed over the step: (1−ξ)(F_ext⁰ − F_int⁰ − A v₀).
+        let mut fixed = vec![0.0; n];
+        if !qs {
+            let mut av0 = vec![0.0; n];
+            if let Some(a) = &self.damping {
+                self.disc.pattern.symmetric_matvec(a, v0, &mut av0);
+            }
+            for i in 0..n {
+                fixed[i] = (1.0 - xi) * (self.f_ext0[i] - self.f_int0[i] - av0[i]);
+            }
+        }
+        let c_mass = if qs { 0.0 } else { 1.0 / (theta * dt * dt) };
+        let c_damp = if qs { 0.0 } else { xi / (theta * dt) };
+        let c_stiff = if qs { 1.0 } else { xi };
+        let mut g = vec![0.0; n];
+        let mut tmp = vec![0.0; n];
+        let mut kbar = vec![0.0; self.disc.pattern.nnz()];
+        let mut first_scale = 0.0f64;
+        for iter in 1..=ts.max_newton {
+            let asm = self.disc.assemble(&u, true);
+            if !(asm.min_j > 0.0) || !asm.energy.is_finite() {
+                return Err(format!(
+                    "an element inverted (min det F = {:.3e}) at Newton iteration {iter}",
+                    asm.min_j
+                ));
+            }
+            let v1: Vec<f64> = (0..n)
+                .map(|i| (u[i] - u0[i]) / (theta * dt) - (1.0 - theta) / theta * v0[i])
+                .collect();
+            // Residual.
+            for i in 0..n {
+                g[i] = c_stiff * (asm.force[i] - f_ext1[i]) - fixed[i];
+            }
+            let mut scale = norm(&asm.force).max(norm(&f_ext1)).max(norm(&fixed));
+            if !qs {
+                tmp.iter_mut().for_each(|x| *x = 0.0);
+                let acc: Vec<f64> = (0..n)
+                    .map(|i| (u[i] - u0[i] - dt * v0[i]) * c_mass)
+                    .collect();
+                self.disc
+                    .pattern
+                    .symmetric_matvec(&self.mass, &acc, &mut tmp);
+                scale = scale.max(norm(&tmp));
+                for i in 0..n {
+                    g[i] += tmp[i];
+                }
+                if let Some(a) = &self.damping {
+                    tmp.iter_mut().for_each(|x| *x = 0.0);
+                    self.disc.pattern.symmetric_matvec(a, &v1, &mut tmp);
+                    for i in 0..n {
+                        g[i] += xi * tmp[i];
+                    }
+                }
+            }
+            let reactions: Vec<f64> = (0..n)
+                .map(|i| if self.constrained[i] { g[i] } else { 0.0 })
+                .collect();
+            for i in 0..n {
+                if self.constrained[i] {
+                    g[i] = 0.0;
+                }
+            }
+            let gnorm = norm(&g);
+            if !gnorm.is_finite() {
+                return Err(format!(
+                    "the residual is not finite at Newton iteration {iter}"
+                ));
+            }
+            first_scale = first_scale.max(scale).max(norm(&reactions));
+            let rel = gnorm / first_scale.max(f64::MIN_POSITIVE);
+            if rel <= ts.newton_tol || gnorm == 0.0 {
+                let du: Vec<f64> = (0..n).map(|i| u[i] - u0[i]).collect();
+                let mut work = 0.0;
+                for i in 0..n {
+                    let f_applied = if qs {
+                        f_ext1[i]
+                    } else {
+                        (1.0 - xi) * self.f_ext0[i] + xi * f_ext1[i]
+                    };
+                    work += du[i] * (f_applied + reactions[i]);
+                }
+                return Ok(Attempt {
+                    v: if qs {
+                        du.iter().map(|d| d / dt).collect()
+                    } else {
+                        v1
+                    },
+                    u,
+                    f_ext1,
+                    f_int1: asm.force,
+                    iterations: iter - 1,
+                    residual: rel,
+                    internal: asm.energy,
+                    work,
+                });
+            }
+            if iter == ts.max_newton {
+                break;
+            }
+            // K̄ = c_stiff K + c_damp A + c_mass M.
+            for (q, k) in kbar.iter_mut().enumerate() {
+                *k = c_stiff * asm.tangent[q] + c_mass * self.mass[q];
+            }
+            if let Some(a) = &self.damping {
+                for (k, av) in kbar.iter_mut().zip(a) {
+                    *k += c_damp * av;
+                }
+            }
+            for &q in &self.zero_positions {
+                kbar[q] = 0.0;
+            }
+            for d in 0..n {
+                if self.constrained[d] {
+                    let q = self.disc.pattern.diagonal_position(d);
+                    if !(kbar[q] > 0.0) {
+                        kbar[q] = 1.0;
+                    }
+                }
+            }
+            self.chol
+                .factorise(&kbar)
+                .map_err(|e| format!("{e} (Newton iteration {iter})"))?;
+            let mut du: Vec<f64> = g.iter().map(|x| -x).collect();
+            self.chol.solve_in_place(&mut du);
+            for i in 0..n {
+                u[i] += du[i];
+            }
+        }
+        Err(format!(
+            "Newton did not converge in {} iterations",
+            ts.max_newton
+        ))
+    }
+}
+
+fn norm(x: &[f64]) -> f64 {
+    x.iter().map(|a| a * a).sum::<f64>().sqrt()
+}
