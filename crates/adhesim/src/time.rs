@@ -358,7 +358,7 @@ impl Stepper {
         let mut g = vec![0.0; n];
         let mut tmp = vec![0.0; n];
         let mut kbar = vec![0.0; self.disc.pattern.nnz()];
-        let mut first_scale = 0.0f64;
+        let mut last_correction_negligible = false;
         for iter in 1..=ts.max_newton {
             let asm = self.disc.assemble(&u, true);
             if !(asm.min_j > 0.0) || !asm.energy.is_finite() {
@@ -409,9 +409,16 @@ impl Stepper {
                     "the residual is not finite at Newton iteration {iter}"
                 ));
             }
-            first_scale = first_scale.max(scale).max(norm(&reactions));
-            let rel = gnorm / first_scale.max(f64::MIN_POSITIVE);
-            if rel <= ts.newton_tol || gnorm == 0.0 {
+            // Force scale of the current iterate (internal, external, inertial forces and
+            // support reactions), so that a large out-of-balance force of an early iterate
+            // does not make later residuals look small.
+            let scale = scale.max(norm(&reactions));
+            let rel = gnorm / scale.max(f64::MIN_POSITIVE);
+            // Converged when the residual is small against the forces, or when the last
+            // correction was negligible against the step's displacement increment (the
+            // residual can sit at its round-off floor when every force is small, e.g. a
+            // vibrating body passing through its rest position).
+            if rel <= ts.newton_tol || gnorm == 0.0 || last_correction_negligible {
                 let du: Vec<f64> = (0..n).map(|i| u[i] - u0[i]).collect();
                 let mut work = 0.0;
                 for i in 0..n {
@@ -468,6 +475,8 @@ impl Stepper {
             for i in 0..n {
                 u[i] += du[i];
             }
+            let increment = (0..n).map(|i| (u[i] - u0[i]).powi(2)).sum::<f64>().sqrt();
+            last_correction_negligible = norm(&du) <= ts.newton_tol * increment;
         }
         Err(format!(
             "Newton did not converge in {} iterations",

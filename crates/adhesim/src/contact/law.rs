@@ -34,6 +34,11 @@ pub const DEFAULT_BETA_EPS: f64 = 1e-4;
 const MAX_INNER: usize = 60;
 /// Largest number of step lengths tried along a Newton direction of the dry force.
 const NEWTON_HALVINGS: usize = 4;
+/// Largest number of step halvings in the line search of the slide equations; a Newton
+/// direction that needs more is abandoned for the bi-potential iteration.
+const SLIDE_HALVINGS: usize = 6;
+/// Largest change of the friction direction per Newton step of the slide equations [rad].
+const MAX_TURN: f64 = 0.5;
 /// Largest number of step halvings in a line search.
 const MAX_HALVINGS: usize = 40;
 
@@ -247,26 +252,39 @@ impl PointSolution {
     }
 }
 
-/// Solves the local problem at one contact point, starting from the dry-force guess `r_start`
-/// [N] (typically the point's force from the previous sweep).
+/// Solves the local problem at one contact point: x = x_free + W_αα (r̄ + r̃) with r̄ obeying
+/// Signorini–Coulomb (r̄ = Proj_K(r̄ − ρ(x + μ‖x_t‖n))) and r̃ = r̃(β₁(x), x) the RCC force.
 ///
-/// The unknown is the dry force r̄; for each r̄ the adhesive part is solved implicitly
-/// (x = x_free + W(r̄ + r̃(x)) with β₁(x), by Newton on the incremental potential, so stiff
-/// adhesion C_n·A·‖W‖ ≫ 1 costs nothing extra). The dry part then iterates on the bi-potential
-/// fixed point r̄ = Proj(r̄ − ρ(x + μ‖x_t‖n)) with a semi-smooth Newton step on the residual
-/// F(r̄) = r̄ − Proj(…), kept when it reduces ‖F‖, and the plain fixed-point step otherwise.
+/// The three cases are tried in turn, each solved exactly rather than by a ρ-dependent fixed
+/// point (whose rate degrades like λ_min/λ_max of the compliance, and with stiff adhesion like
+/// 1/(C·A·‖W‖)):
+/// 1. apart: r̄ = 0; the adhesive part alone, x = x_free + W r̃(x), is solved implicitly
+///    (Newton on the incremental potential with a line search, started from linear springs at
+///    β₀, so a bond holds as long as its branch exists and snaps off past it). Valid if x_n ≥ 0.
+/// 2. stick: x = 0, so r̃ = r̃(0) is explicit and r̄ = −W⁻¹x_free − r̃(0). Valid if r̄ ∈ K_μ.
+/// 3. slide: damped Newton on (r_n, θ, λ) with r̄ = r_n(μ cos θ, μ sin θ, 1) on the cone and
+///    slip x_t = −λ(cos θ, sin θ), x_n = 0, started from the friction direction of `r_start` when
+///    that lies on the cone (warm start from the previous sweep), else of the stick force.
 ///
-/// Convergence: with r = r̄ + r̃ and the force scale
-/// s = ρ‖x_free‖ + A·√(max(C_n, C_t)·w), both the change of r over an iteration and the
-/// fixed-point defect ‖F‖ are ≤ `tol`·(‖r‖ + s). The returned r̄ is the final projection (so it
-/// lies in the cone exactly), and x, β₁, r̃ are evaluated at it.
+/// A case is accepted only if it passes the bi-potential check: with r = r̄ + r̃ and the force
+/// scale s = ρ‖x_free‖ + A·√(max(C_n, C_t)·w), ‖r̄ − Proj_K(r̄ − ρ(x + μ‖x_t‖n))‖ ≤
+/// `tol`·(‖r‖ + s). If none does (singular or stalled slide Newton, e.g. a tangential snap of
+/// the bond), the bi-potential iteration takes over from `r_start`: semi-smooth Newton steps on
+/// that residual, kept when they reduce it, plain fixed-point steps otherwise; it stops when the
+/// change of r over an iteration and the residual are both ≤ `tol`·(‖r‖ + s).
+///
+/// `iterations` counts 1 for the apart test, 1 for the stick test, then the Newton steps of the
+/// slide equations and of the fallback. When the law admits several solutions (μ large with
+/// strongly coupled W, or softening adhesion), the first in the order apart, stick, slide wins.
+/// `rho` is only used by the check and the fallback (a non-positive ρ is replaced by
+/// [`default_rho`]); the solution does not depend on it. r̄ lies in K_μ to rounding.
 pub fn solve_point(
     p: &PointProblem,
     r_start: [f64; 3],
     tol: f64,
     max_iter: usize,
 ) -> PointSolution {
-    solve_point_impl(p, r_start, tol, max_iter, true)
+    solve_point_impl(p, r_start, tol, max_iter, Method::Cases)
 }
 
 /// Everything derived from one value of the dry force r̄.
@@ -310,10 +328,24 @@ struct AdhEval {
 struct Ctx<'a> {
     p: &'a PointProblem<'a>,
     mu: f64,
+    /// ρ [N/m] in use (the problem's, or [`default_rho`] when that is not positive).
+    rho: f64,
+    /// Relative tolerance of the point problem.
+    tol: f64,
     /// Force scale s [N] of the convergence criteria.
     scale: f64,
     /// Relative tolerance of the adhesive sub-problem.
     tol_in: f64,
+}
+
+/// How [`solve_point_impl`] solves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Method {
+    /// Case by case (apart, stick, slide), falling back to the bi-potential iteration.
+    Cases,
+    /// Bi-potential iteration only; `newton` enables the semi-smooth Newton steps.
+    #[cfg_attr(not(test), allow(dead_code))]
+    Bipotential { newton: bool },
 }
 
 fn solve_point_impl(
@@ -321,14 +353,19 @@ fn solve_point_impl(
     r_start: V3,
     tol: f64,
     max_iter: usize,
-    newton: bool,
+    method: Method,
 ) -> PointSolution {
     let mu = p.law.mu.max(0.0);
     let adh_scale = match &p.law.adhesion {
         Some(a) => p.area.abs() * a.peak_traction(),
         None => 0.0,
     };
-    let scale = p.rho.abs() * norm(p.x_free) + adh_scale;
+    let rho = if p.rho.is_finite() && p.rho > 0.0 {
+        p.rho
+    } else {
+        default_rho(p.w_aa)
+    };
+    let scale = rho * norm(p.x_free) + adh_scale;
     let tol = if tol.is_finite() && tol > 0.0 {
         tol
     } else {
@@ -337,7 +374,9 @@ fn solve_point_impl(
     let ctx = Ctx {
         p,
         mu,
+        rho,
         scale,
+        tol,
         tol_in: (1e-3 * tol).max(1e-13),
     };
     let r0 = if r_start.iter().all(|v| v.is_finite()) {
@@ -345,8 +384,247 @@ fn solve_point_impl(
     } else {
         [0.0; 3]
     };
+    let mut used = 0;
+    let newton = match method {
+        Method::Cases => {
+            match solve_by_cases(&ctx, r0, max_iter) {
+                Ok(sol) => return sol,
+                Err(n) => used = n,
+            }
+            true
+        }
+        Method::Bipotential { newton } => newton,
+    };
+    bipotential_iteration(&ctx, r0, max_iter.saturating_sub(used), newton, used)
+}
+
+/// Whether `ev` satisfies the law: fixed-point defect ‖F‖ ≤ tol·(‖r‖ + s).
+fn is_solution(ctx: &Ctx, ev: &Eval) -> bool {
+    norm(ev.f) <= ctx.tol * (norm(add(ev.r_dry, ev.r_adh)) + ctx.scale)
+}
+
+/// Packs an evaluation into a [`PointSolution`].
+fn finish(ev: &Eval, state: ContactState, iterations: usize, converged: bool) -> PointSolution {
+    let ut = if ev.adh.beta > 0.0 {
+        ev.adh.ut
+    } else {
+        [0.0; 2]
+    };
+    PointSolution {
+        r_dry: ev.r_dry,
+        r_adh: ev.r_adh,
+        x: ev.x,
+        beta: ev.adh.beta,
+        ut,
+        state,
+        iterations,
+        converged,
+    }
+}
+
+/// Solves the three cases in turn and returns the first one that passes [`is_solution`]:
+/// apart (r̄ = 0, the adhesive sub-problem alone, valid when x_n ≥ 0), stick (x = 0, so
+/// r̄ = −W⁻¹x_free − r̃(0), valid when r̄ ∈ K_μ), slide (Newton's method on the slide equations).
+/// `Err` carries the iterations spent.
+fn solve_by_cases(ctx: &Ctx, r_start: V3, max_iter: usize) -> Result<PointSolution, usize> {
+    let p = ctx.p;
+    if max_iter == 0 {
+        return Err(0);
+    }
+    // Apart.
+    let ev = evaluate(ctx, [0.0; 3], frozen_adhesion_guess(p, p.x_free));
+    if ev.x[2] >= 0.0 && is_solution(ctx, &ev) {
+        return Ok(finish(&ev, ContactState::Apart, 1, true));
+    }
+    // Stick.
+    let r_adh0 = match &p.law.adhesion {
+        Some(a) => adhesion_eval(p, a, [0.0; 3]).force,
+        None => [0.0; 3],
+    };
+    let r_stick = solve3(p.w_aa, neg(p.x_free)).map(|r| sub(r, r_adh0));
+    if let Some(rs) = r_stick {
+        if rs[2] >= 0.0 && norm2(rs[0], rs[1]) <= ctx.mu * rs[2] {
+            let ev = evaluate(ctx, rs, r_adh0);
+            if is_solution(ctx, &ev) {
+                return Ok(finish(&ev, ContactState::Stick, 2, true));
+            }
+        }
+    }
+    // Slide.
+    let mut used = 2;
+    if max_iter > used {
+        let (ev, n) = solve_slide(ctx, r_start, r_stick, r_adh0, max_iter - used);
+        used += n;
+        if let Some(ev) = ev {
+            if is_solution(ctx, &ev) {
+                return Ok(finish(&ev, ContactState::Slide, used, true));
+            }
+        }
+    }
+    Err(used)
+}
+
+/// Slide equations in the unknowns (r_n, θ, λ): r̄ = r_n (μ cos θ, μ sin θ, 1) on the cone,
+/// slip x_t = −λ (cos θ, sin θ) opposing the friction force, x_n = 0:
+/// R = x_free + W (r̄ + r̃(x)) − x = 0. Returns R [m], ∂R/∂(r_n, θ, λ), r̄ and r̃.
+fn slide_residual(ctx: &Ctx, q: V3) -> (V3, M3, V3, V3) {
+    let p = ctx.p;
+    let (rn, th, lam) = (q[0], q[1], q[2]);
+    let c = [th.cos(), th.sin()];
+    let cp = [-c[1], c[0]];
+    let mu = ctx.mu;
+    let x = [-lam * c[0], -lam * c[1], 0.0];
+    let rd = [mu * rn * c[0], mu * rn * c[1], rn];
+    let (ra, k) = match &p.law.adhesion {
+        Some(a) => {
+            let ad = adhesion_eval(p, a, x);
+            (ad.force, ad.stiff)
+        }
+        None => ([0.0; 3], [[0.0; 3]; 3]),
+    };
+    let w = p.w_aa;
+    let res = sub(add(p.x_free, matvec(w, add(rd, ra))), x);
+    // ∂R/∂x = −(I + W K) on the tangential columns.
+    let mut a = identity();
+    let wk = matmul(w, k);
+    for i in 0..3 {
+        for j in 0..3 {
+            a[i][j] += wk[i][j];
+        }
+    }
+    let d_rn = matvec(w, [mu * c[0], mu * c[1], 1.0]);
+    let d_lam = matvec(a, [c[0], c[1], 0.0]);
+    let d_th = add(
+        matvec(w, [mu * rn * cp[0], mu * rn * cp[1], 0.0]),
+        matvec(a, [lam * cp[0], lam * cp[1], 0.0]),
+    );
+    let jac = [
+        [d_rn[0], d_th[0], d_lam[0]],
+        [d_rn[1], d_th[1], d_lam[1]],
+        [d_rn[2], d_th[2], d_lam[2]],
+    ];
+    (res, jac, rd, ra)
+}
+
+/// Newton's method with a backtracking line search on ‖R‖ for the slide equations, started from
+/// the friction direction of `r_start` when it lies on the cone, else from the projection of the
+/// stick force. Returns the evaluation at the converged dry force and the iterations spent.
+fn solve_slide(
+    ctx: &Ctx,
+    r_start: V3,
+    r_stick: Option<V3>,
+    r_adh0: V3,
+    max_iter: usize,
+) -> (Option<Eval>, usize) {
+    let mu = ctx.mu;
+    let on_cone = |r: V3| {
+        let t = norm2(r[0], r[1]);
+        r[2] > 0.0 && t > 0.0 && (t - mu * r[2]).abs() <= 1e-6 * t
+    };
+    let base = if on_cone(r_start) {
+        r_start
+    } else {
+        match r_stick {
+            Some(rs) => {
+                let (pr, _) = dry_projection(rs, mu);
+                if norm2(pr[0], pr[1]) > 0.0 {
+                    pr
+                } else {
+                    [rs[0], rs[1], pr[2]]
+                }
+            }
+            None => r_start,
+        }
+    };
+    let th0 = if norm2(base[0], base[1]) > 0.0 {
+        base[1].atan2(base[0])
+    } else {
+        0.0
+    };
+    let mut q = [base[2].max(0.0), th0, 0.0];
+    let (mut res, mut jac, mut rd, mut ra) = slide_residual(ctx, q);
+    // At the first friction direction, (r_n, λ) by least squares on the linearised equations.
+    if let Some((dn, dl)) = least_squares_2(jac, res) {
+        let q1 = [q[0] + dn, q[1], (q[2] + dl).max(0.0)];
+        let trial = slide_residual(ctx, q1);
+        if norm(trial.0) < norm(res) {
+            q = q1;
+            (res, jac, rd, ra) = trial;
+        }
+    }
+    let mut iterations = 0;
+    let mut converged = false;
+    while iterations < max_iter {
+        iterations += 1;
+        let mut d = match solve3(jac, neg(res)) {
+            Some(d) if d.iter().all(|v| v.is_finite()) => d,
+            _ => break,
+        };
+        if d[1].abs() > MAX_TURN {
+            let k = MAX_TURN / d[1].abs();
+            d = [k * d[0], k * d[1], k * d[2]];
+        }
+        let r_old = add(rd, ra);
+        let m0 = norm(res);
+        let mut alpha = 1.0;
+        let mut accepted = false;
+        for _ in 0..SLIDE_HALVINGS {
+            let qt = axpy(q, alpha, d);
+            let trial = slide_residual(ctx, qt);
+            if norm(trial.0) <= (1.0 - 1e-4 * alpha) * m0 || norm(trial.0) == 0.0 {
+                q = qt;
+                (res, jac, rd, ra) = trial;
+                accepted = true;
+                break;
+            }
+            alpha *= 0.5;
+        }
+        if !accepted {
+            // No further decrease possible: converged if the residual is already negligible.
+            converged = ctx.rho * m0 <= ctx.tol * (norm(r_old) + ctx.scale);
+            break;
+        }
+        let r_new = add(rd, ra);
+        let bound = ctx.tol * (norm(r_new) + ctx.scale);
+        if norm(sub(r_new, r_old)) <= bound && ctx.rho * norm(res) <= bound {
+            converged = true;
+            break;
+        }
+    }
+    if !converged {
+        return (None, iterations);
+    }
+    let guess = if ra == [0.0; 3] { r_adh0 } else { ra };
+    (Some(evaluate(ctx, rd, guess)), iterations)
+}
+
+/// Least-squares solution (a, b) of a·J[:,0] + b·J[:,2] = −res (the r_n and λ columns of the
+/// slide Jacobian).
+fn least_squares_2(jac: M3, res: V3) -> Option<(f64, f64)> {
+    let c0 = [jac[0][0], jac[1][0], jac[2][0]];
+    let c2 = [jac[0][2], jac[1][2], jac[2][2]];
+    let (a11, a12, a22) = (dot(c0, c0), dot(c0, c2), dot(c2, c2));
+    let (b1, b2) = (-dot(c0, res), -dot(c2, res));
+    let det = a11 * a22 - a12 * a12;
+    if !(det.is_finite() && det > 1e-14 * a11 * a22) {
+        return None;
+    }
+    Some(((b1 * a22 - b2 * a12) / det, (a11 * b2 - a12 * b1) / det))
+}
+
+/// The bi-potential iteration on the dry force: r̄ ← Proj(r̄ − ρ(x + μ‖x_t‖n)) with x from the
+/// implicit adhesive sub-problem, optionally accelerated by semi-smooth Newton steps kept when
+/// they reduce ‖F‖. `offset` iterations were already spent.
+fn bipotential_iteration(
+    ctx: &Ctx,
+    r0: V3,
+    max_iter: usize,
+    newton: bool,
+    offset: usize,
+) -> PointSolution {
+    let p = ctx.p;
     let z0 = frozen_adhesion_guess(p, add(p.x_free, matvec(p.w_aa, r0)));
-    let mut ev = evaluate(&ctx, r0, z0);
+    let mut ev = evaluate(ctx, r0, z0);
     let mut iterations = 0;
     let mut converged = false;
     while iterations < max_iter {
@@ -355,11 +633,11 @@ fn solve_point_impl(
         let fn_old = norm(ev.f);
         let mut next = None;
         if newton {
-            if let Some(step) = newton_step(&ctx, &ev) {
+            if let Some(step) = newton_step(ctx, &ev) {
                 let mut alpha = 1.0;
                 for _ in 0..NEWTON_HALVINGS {
-                    let trial = dry_projection(axpy(ev.r_dry, alpha, step), mu).0;
-                    let cand = evaluate(&ctx, trial, ev.r_adh);
+                    let trial = dry_projection(axpy(ev.r_dry, alpha, step), ctx.mu).0;
+                    let cand = evaluate(ctx, trial, ev.r_adh);
                     if norm(cand.f) < (1.0 - 1e-4 * alpha) * fn_old {
                         next = Some(cand);
                         break;
@@ -368,47 +646,20 @@ fn solve_point_impl(
                 }
             }
         }
-        let next_is = next.is_some();
         ev = match next {
             Some(cand) => cand,
-            None => evaluate(&ctx, ev.proj, ev.r_adh),
+            None => evaluate(ctx, ev.proj, ev.r_adh),
         };
         let r_new = add(ev.r_dry, ev.r_adh);
-        if std::env::var("LAWDBG").is_ok() {
-            eprintln!(
-                "it {iterations} newton {} rd {:?} radh {:?} x {:?} beta {} case {:?} |f| {:e}",
-                next_is,
-                ev.r_dry,
-                ev.r_adh,
-                ev.x,
-                ev.adh.beta,
-                ev.case,
-                norm(ev.f)
-            );
-        }
-        let bound = tol * (norm(r_new) + scale);
+        let bound = ctx.tol * (norm(r_new) + ctx.scale);
         if norm(sub(r_new, r_old)) <= bound && norm(ev.f) <= bound {
             converged = true;
             break;
         }
     }
     let state = ev.case;
-    let fin = evaluate(&ctx, ev.proj, ev.r_adh);
-    let ut = if fin.adh.beta > 0.0 {
-        fin.adh.ut
-    } else {
-        [0.0; 2]
-    };
-    PointSolution {
-        r_dry: fin.r_dry,
-        r_adh: fin.r_adh,
-        x: fin.x,
-        beta: fin.adh.beta,
-        ut,
-        state,
-        iterations,
-        converged,
-    }
+    let fin = evaluate(ctx, ev.proj, ev.r_adh);
+    finish(&fin, state, offset + iterations, converged)
 }
 
 /// Evaluates x, the adhesive part and the projection at the dry force `r_dry`, solving the
@@ -420,7 +671,7 @@ fn evaluate(ctx: &Ctx, r_dry: V3, z_start: V3) -> Eval {
         Some(a) => solve_adhesion(ctx, a, y, z_start),
         None => (y, [0.0; 3], AdhEval::default()),
     };
-    let r_star = bipotential_trial(r_dry, x, ctx.mu, p.rho);
+    let r_star = bipotential_trial(r_dry, x, ctx.mu, ctx.rho);
     let (proj, case) = dry_projection(r_star, ctx.mu);
     Eval {
         r_dry,
@@ -520,7 +771,7 @@ fn frozen_adhesion_guess(p: &PointProblem, y: V3) -> V3 {
     };
     let b0 = clamp01(p.bond0.beta);
     let k = p.area * b0 * b0;
-    if !(k > 0.0) {
+    if k.is_nan() || k <= 0.0 {
         return [0.0; 3];
     }
     let kd = [k * a.ct, k * a.ct, if y[2] > 0.0 { k * a.cn } else { 0.0 }];
@@ -530,9 +781,9 @@ fn frozen_adhesion_guess(p: &PointProblem, y: V3) -> V3 {
         -kd[2] * y[2],
     ];
     let mut m = identity();
-    for i in 0..3 {
-        for j in 0..3 {
-            m[i][j] += kd[i] * p.w_aa[i][j];
+    for (i, row) in m.iter_mut().enumerate() {
+        for (v, wij) in row.iter_mut().zip(p.w_aa[i]) {
+            *v += kd[i] * wij;
         }
     }
     match solve3(m, rhs) {
@@ -625,7 +876,7 @@ fn shifted_newton_direction(w: M3, k: M3, grad: V3) -> Option<V3> {
     let h = sym(add_m(w, matmul(w, matmul(k, w))));
     let ev = eig_sym3(h);
     let big = ev[0].abs().max(ev[2].abs());
-    if !(big > 0.0) || !big.is_finite() {
+    if !(big.is_finite() && big > 0.0) {
         return None;
     }
     let shift = (-ev[0]).max(0.0) + 1e-6 * big;
@@ -659,7 +910,7 @@ fn newton_step(ctx: &Ctx, ev: &Eval) -> Option<V3> {
     let mut a = identity();
     for i in 0..3 {
         for j in 0..3 {
-            a[i][j] -= p.rho * gw[i][j];
+            a[i][j] -= ctx.rho * gw[i][j];
         }
     }
     let pj = projection_jacobian(ev.r_star, ctx.mu, ev.case);
@@ -681,7 +932,7 @@ fn projection_jacobian(r_star: V3, mu: f64, case: ContactState) -> M3 {
         ContactState::Slide => {
             let s = norm2(r_star[0], r_star[1]);
             let q = 1.0 + mu * mu;
-            if !(s > 0.0) {
+            if s.is_nan() || s <= 0.0 {
                 let mut j = [[0.0; 3]; 3];
                 j[2][2] = 1.0 / q;
                 return j;
@@ -791,7 +1042,7 @@ fn solve3(m: M3, b: V3) -> Option<V3> {
         .iter()
         .flat_map(|row| row.iter())
         .fold(0.0_f64, |acc, v| acc.max(v.abs()));
-    if !(big > 0.0) || !big.is_finite() {
+    if !(big.is_finite() && big > 0.0) {
         return None;
     }
     for col in 0..3 {
@@ -801,15 +1052,17 @@ fn solve3(m: M3, b: V3) -> Option<V3> {
                 piv = row;
             }
         }
-        if !(a[piv][col].abs() > 1e-14 * big) {
+        let pivot = a[piv][col].abs();
+        if pivot.is_nan() || pivot <= 1e-14 * big {
             return None;
         }
         a.swap(col, piv);
         r.swap(col, piv);
         for row in col + 1..3 {
             let f = a[row][col] / a[col][col];
-            for k in col..3 {
-                a[row][k] -= f * a[col][k];
+            let pivot_row = a[col];
+            for (v, pv) in a[row].iter_mut().zip(pivot_row).skip(col) {
+                *v -= f * pv;
             }
             r[row] -= f * r[col];
         }
@@ -844,7 +1097,7 @@ fn eig_sym3(a: M3) -> V3 {
     let d = [a[0][0] - q, a[1][1] - q, a[2][2] - q];
     let p2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + 2.0 * p1;
     let p = (p2 / 6.0).sqrt();
-    if !(p > 0.0) {
+    if p.is_nan() || p <= 0.0 {
         return [q, q, q];
     }
     let mut b = a;
@@ -1311,54 +1564,89 @@ mod tests {
                 x_peak = x;
             }
         }
-        assert!(max_dev < 1e-3, "traction deviates by {max_dev} of the peak");
-        assert!(rel(peak, (p.cn * p.w).sqrt()) < 1e-3, "peak {peak}");
+        assert!(max_dev < 1e-5, "traction deviates by {max_dev} of the peak");
+        assert!(rel(peak, (p.cn * p.w).sqrt()) < 1e-9, "peak {peak}");
         assert!(
-            (x_peak - xc).abs() <= 2e-3 * xc,
+            (x_peak - xc).abs() <= 1e-3 * xc,
             "peak at {} x_c",
             x_peak / xc
         );
-        assert!(rel(work, p.w) < 2e-3, "work {work} vs w = {}", p.w);
+        // Work of separation: w, less the tail beyond the cut-off (β∞ = ε at x = x_c/√ε), which
+        // carries ∫ w²/(C_n x³) dx = w ε/2.
+        assert!(rel(work, p.w) < 1e-4, "work {work} vs w = {}", p.w);
+        assert!(rel(work, p.w * (1.0 - 0.5 * p.eps)) < 1e-5, "work {work}");
         assert_eq!(beta, 0.0, "the bond is broken at 300 x_c");
     }
 
-    // ------------------------------------------------------------------ point solver
+    #[test]
+    fn pull_off_through_the_point_solver() {
+        // A soft-adhesion point (C_n A W_nn = 2e-3) pulled open quasi-statically (b = 1e-6,
+        // Δt = 1 s): the tensile force follows A·C_n x min(1, w/(C_n x²))² at the solved gap and
+        // peaks at A·√(C_n w).
+        let rcc = RccParams::new(20.0, 2e9, 2e9, 1e-6);
+        let law = InterfaceLaw {
+            mu: 0.3,
+            adhesion: Some(rcc),
+        };
+        let xc = rcc.critical_opening();
+        let area = 1e-6;
+        let w = diag(1e-6, 1e-6, 1e-6);
+        let mut bond = BondState {
+            beta: 1.0,
+            ut: [0.0; 2],
+        };
+        let mut peak = 0.0_f64;
+        for k in 1..=10_000 {
+            let a = 1e-3 * k as f64 * xc;
+            let mut p = problem(&law, w, [0.0, 0.0, a], bond);
+            p.dt = 1.0;
+            let s = solve_point(&p, [0.0; 3], 1e-12, 50);
+            assert!(s.converged && s.iterations == 1, "step {k}: {s:?}");
+            assert_eq!(s.state, ContactState::Apart);
+            let x = s.x[2];
+            let b = (rcc.w / (rcc.cn * x * x)).min(1.0);
+            let expect = area * rcc.cn * x * b * b;
+            let scale = area * rcc.peak_traction();
+            assert!((-s.r()[2] - expect).abs() <= 1e-5 * scale, "step {k}");
+            peak = peak.max(-s.r()[2]);
+            bond = BondState {
+                beta: s.beta,
+                ut: s.ut,
+            };
+        }
+        assert!(
+            rel(peak, area * (rcc.cn * rcc.w).sqrt()) < 1e-4,
+            "peak {peak}"
+        );
+    }
 
     #[test]
-    fn dbg_case() {
+    fn stiff_adhesion_in_contact_sheared() {
+        // C_t A W_tt = C_n A W_nn = 100, bonded (β₀ = 1) with a stretched link, pressed and
+        // sheared: stick below the friction limit, slide above; the answer comes in ≤ 8
+        // iterations either way.
         let law = InterfaceLaw {
-            mu: 1.2,
-            adhesion: Some(RccParams {
-                w: 20.0,
-                cn: 2000000000.0,
-                ct: 2000000000.0,
-                b: 1e-6,
-                eps: 0.0001,
-            }),
+            mu: 0.4,
+            adhesion: Some(paper_rcc()),
         };
-        let p = PointProblem {
-            w_aa: [
-                [1.7002235845590745, -0.4678283269036566, 1.3912302746200687],
-                [-0.4678283269036567, 4.930083937426607, 0.28487967169134215],
-                [1.3912302746200687, 0.2848796716913422, 2.2737067430584563],
-            ],
-            x_free: [
-                -0.004875768019883796,
-                0.014494092234334942,
-                -0.017063513770316244,
-            ],
-            law: &law,
-            bond0: BondState {
-                beta: 1.0,
-                ut: [-2.5273372863015965e-5, -2.797668651169949e-5],
-            },
-            dt: 0.0001,
-            area: 1e-6,
-            rho: 0.19999999999999993,
+        let w = diag(0.05, 0.05, 0.05);
+        let bond = BondState {
+            beta: 1.0,
+            ut: [2e-5, 0.0],
         };
-        let s = solve_point(&p, [0.0; 3], 1e-10, 30);
-        eprintln!("{s:?}");
+        // r̃(0) = (−0.04, 0, 0) N; pressing with 0.2 N gives μ r_n = 0.08 N.
+        for (shear, state) in [(0.0, ContactState::Stick), (-5e-3, ContactState::Slide)] {
+            let p = problem(&law, w, [shear, 0.0, -1e-2], bond);
+            let s = solve_point(&p, [0.0; 3], 1e-12, 50);
+            assert!(s.converged);
+            assert_eq!(s.state, state, "shear {shear}");
+            assert!(s.iterations <= 8, "{} iterations", s.iterations);
+            check_solution(&p, &s, 1e-10);
+            assert!(rel(s.r()[2], 0.2) < 1e-10);
+        }
     }
+
+    // ------------------------------------------------------------------ point solver
 
     #[test]
     fn default_rho_is_inverse_largest_eigenvalue() {
@@ -1549,32 +1837,54 @@ mod tests {
 
     #[test]
     fn converges_fast_over_stiffness_ratios() {
+        // 1500 random problems: C_n A λ_max(W) ∈ {dry, 0.01, 1, 100, 1e4}, diagonal or coupled
+        // W (condition number up to 10), μ ∈ {0, 0.2, 0.4, 0.8, 1.2}, b ∈ {0.1, 1e-6, 0},
+        // β₀ ∈ {0, 0.01, 0.5, 1}, random stretch and loads from 0.01 to 5 (1 + ratio) x_c.
         let mut rng = Rng(2024);
-        let mut worst = 0;
-        let mut total = 0;
-        let mut count = 0;
+        let mut stats = [(0usize, 0usize, 0usize); 5];
         let mut states = [0usize; 3];
         sweep_cases(&mut rng, 1500, |p, label| {
             let s = solve_point(p, [0.0; 3], 1e-10, 50);
             assert!(s.converged, "{label}: {s:?} {p:?}");
             check_solution(p, &s, 1e-8);
-            worst = worst.max(s.iterations);
-            total += s.iterations;
-            count += 1;
+            let k = label_ratio_index(label);
+            stats[k].0 = stats[k].0.max(s.iterations);
+            stats[k].1 += s.iterations;
+            stats[k].2 += 1;
             states[s.state as usize] += 1;
         });
-        let mean = total as f64 / count as f64;
-        assert!(worst <= 12, "worst {worst} iterations");
-        assert!(mean <= 5.0, "mean {mean} iterations");
-        assert!(states.iter().all(|&n| n > 100), "states {states:?}");
+        for (k, (worst, total, n)) in stats.iter().enumerate() {
+            let mean = *total as f64 / *n as f64;
+            eprintln!("ratio class {k}: worst {worst}, mean {mean:.2} iterations over {n}");
+            let (worst_max, mean_max) = if k <= 2 { (10, 4.0) } else { (16, 5.0) };
+            assert!(
+                *worst <= worst_max && mean <= mean_max,
+                "class {k}: {worst} {mean}"
+            );
+        }
+        assert!(states.iter().all(|&n| n > 30), "states {states:?}");
+    }
+
+    fn label_ratio_index(label: &str) -> usize {
+        let ratio = label
+            .split("ratio ")
+            .nth(1)
+            .and_then(|t| t.split(',').next());
+        match ratio {
+            Some("0") => 0,
+            Some("0.01") => 1,
+            Some("1") => 2,
+            Some("100") => 3,
+            _ => 4,
+        }
     }
 
     #[test]
     fn plain_fixed_point_with_default_rho_converges_for_dry_contact() {
-        // Without the Newton step: the bi-potential fixed point with ρ = 1/λ_max converges (the
-        // reference the accelerated solver must agree with), while ρ = 1/max W_ii can diverge.
+        // The bi-potential fixed point alone (no Newton step) with ρ = 1/λ_max converges and
+        // agrees with the case-by-case solver.
         let mut rng = Rng(99);
-        let mut diverged_with_diag_rho = 0;
+        let mut worst = 0;
         for i in 0..300 {
             let w = rng.spd(1e-6, 1e-5);
             let law = InterfaceLaw {
@@ -1586,20 +1896,64 @@ mod tests {
                 rng.uniform(-1e-4, 1e-4),
                 rng.uniform(-1e-4, 1e-4),
             ];
-            let mut p = problem(&law, w, x_free, BondState::default());
-            let fp = solve_point_impl(&p, [0.0; 3], 1e-10, 20_000, false);
+            let p = problem(&law, w, x_free, BondState::default());
+            let fp = solve_point_impl(
+                &p,
+                [0.0; 3],
+                1e-10,
+                5000,
+                Method::Bipotential { newton: false },
+            );
             assert!(fp.converged, "case {i}");
+            worst = worst.max(fp.iterations);
             let nw = solve_point(&p, [0.0; 3], 1e-10, 50);
             assert!(nw.converged);
+            assert_eq!(fp.state, nw.state, "case {i}");
             let scale = norm(fp.r()) + p.rho * norm(x_free);
-            assert!(norm(sub(fp.r(), nw.r())) <= 1e-7 * scale, "case {i}");
-            p.rho = 1.0 / w[0][0].max(w[1][1]).max(w[2][2]);
-            let fd = solve_point_impl(&p, [0.0; 3], 1e-10, 20_000, false);
-            if !fd.converged {
-                diverged_with_diag_rho += 1;
+            assert!(norm(sub(fp.r(), nw.r())) <= 1e-8 * scale, "case {i}");
+        }
+        // Condition number 10: the fixed point needs ~κ·ln(1/tol) iterations.
+        assert!(worst <= 400, "worst {worst}");
+    }
+
+    #[test]
+    fn rho_from_max_diagonal_can_diverge() {
+        // W = εI + (1 − ε) v vᵀ, v = (1, 1, 1)/√3: λ_max = 1 but W_ii ≈ 1/3, so ρ = 1/max W_ii ≈ 3
+        // exceeds 2/λ_max and the sticking iteration r ← r − ρ W r − ρ x_free diverges.
+        let eps = 0.05;
+        let mut w = [[0.0; 3]; 3];
+        for (i, row) in w.iter_mut().enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = (1.0 - eps) / 3.0 + if i == j { eps } else { 0.0 };
             }
         }
-        eprintln!("ρ = 1/max W_ii failed in {diverged_with_diag_rho} of 300 cases");
+        let law = InterfaceLaw {
+            mu: 1.0,
+            adhesion: None,
+        };
+        let mut p = problem(&law, w, [0.0, 0.0, -1.0], BondState::default());
+        let ok = solve_point_impl(
+            &p,
+            [0.0; 3],
+            1e-10,
+            5000,
+            Method::Bipotential { newton: false },
+        );
+        assert!(ok.converged);
+        check_solution(&p, &ok, 1e-8);
+        p.rho = 1.0 / w[0][0];
+        let bad = solve_point_impl(
+            &p,
+            [0.0; 3],
+            1e-10,
+            5000,
+            Method::Bipotential { newton: false },
+        );
+        assert!(!bad.converged);
+        // The default solver does not depend on ρ for its answer.
+        let s = solve_point(&p, [0.0; 3], 1e-10, 50);
+        assert!(s.converged);
+        assert!(norm(sub(s.r(), ok.r())) <= 1e-8 * norm(ok.r()));
     }
 
     #[test]

@@ -824,7 +824,7 @@ mod tests {
         assert!(y_label > 50, "y label pixels: {y_label}");
         // The legend column right of the plot holds a sample of every series' colour.
         for c in &PALETTE[..3] {
-            let n = count(&buf, (880, W), (40, 200), |p| near(p, *c, 10));
+            let n = count(&buf, (800, W), (40, 200), |p| near(p, *c, 10));
             assert!(n > 20, "legend sample of {c:?}: {n} pixels");
         }
     }

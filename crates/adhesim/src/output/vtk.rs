@@ -119,7 +119,7 @@ impl FieldData<'_> {
         self.len() == 0
     }
 
-    /// Components per entry (1, 3, 9 or 1).
+    /// Components per entry: 1 for `Scalar` and `Int`, 3 for `Vector`, 9 for `Tensor`.
     pub fn num_components(&self) -> usize {
         self.kind().components()
     }
