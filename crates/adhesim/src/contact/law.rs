@@ -22,6 +22,11 @@
 //!   gap `x` a bond forms when `w/(C_n x²) ≥ ε`, i.e. `x ≤ √(w/(ε C_n)) = 100 x_c` for ε = 1e-4
 //!   (`x_c = √(w/C_n)`). Its traction there is at most `w²/(C_n x³)`. Candidates beyond the
 //!   detection distance are the caller's business: they carry `β = 0` (model.md §5).
+//! - **Point solver.** [`solve_point`] solves the apart, stick and slide cases directly (the
+//!   adhesive part implicitly in x) and checks each against the bi-potential fixed point; the
+//!   bi-potential iteration itself (semi-smooth Newton, fixed-point steps with ρ = 1/λ_max(W))
+//!   is the fallback. A plain fixed point diverges once C·A·‖W‖ > 1 if r̃ lags one iteration
+//!   behind x, and crawls when the compliance is ill-conditioned.
 //! - **Sign of the sliding projection.** The paper's eq 32 prints `+ μ n`; with `r_n > 0` as
 //!   compression that leaves the cone, so `− μ n` is used, as model.md says.
 
@@ -159,7 +164,8 @@ pub fn bipotential_trial(r_dry: [f64; 3], x: [f64; 3], mu: f64, rho: f64) -> [f6
 
 /// Intensity of adhesion at the end of a step of `dt` [s] from `beta0`, by implicit Euler of
 /// b β̇ = w − (C_n x_n⁺² + C_t‖u_t‖²) β held in [0, 1]:
-/// β₁ = min(1, (b β₀ + Δt w)/(b + Δt E)), E = C_n x_n⁺² + C_t‖u_t‖² [J/m²·…, N/m].
+/// β₁ = min(1, (b β₀ + Δt w)/(b + Δt E)), with the stretch energy E = C_n x_n⁺² + C_t‖u_t‖²
+/// [J/m²].
 ///
 /// - `xn` [m] is the gap (only its positive part stretches the links), `ut` [m] the accumulated
 ///   bond stretch including this step's slip.
@@ -232,9 +238,10 @@ pub struct PointSolution {
     pub beta: f64,
     /// Bond stretch to commit [m]: u_t0 + x_t while bonded (β₁ > 0), else 0.
     pub ut: [f64; 2],
-    /// Case of the final projection of the dry part.
+    /// Case of the solution: apart (r̄ = 0, x_n ≥ 0), stick (x = 0) or slide (r̄ on the cone,
+    /// opposing the slip, x_n = 0). Whether the point is bonded is `beta > 0`.
     pub state: ContactState,
-    /// Outer iterations performed.
+    /// Iterations spent, counted as in [`solve_point`].
     pub iterations: usize,
     /// Whether the convergence criterion was met within `max_iter`.
     pub converged: bool,
