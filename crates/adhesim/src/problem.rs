@@ -191,6 +191,8 @@ pub struct Problem {
     pub gravity: [f64; 3],
     /// Time integration.
     pub time: TimeSettings,
+    /// Contact pairs.
+    pub contacts: Vec<crate::contact::ContactPair>,
     /// Tracked nodes.
     pub tracks: Vec<Track>,
     /// Output frequency.

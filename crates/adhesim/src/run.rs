@@ -128,6 +128,7 @@ pub fn run(
             disc: &stepper.disc,
             state: &stepper.state,
             report: &initial,
+            contact: &stepper.contact,
         };
         frames.observe(&view).map_err(io_err)?;
         history.observe(&view).map_err(io_err)?;
@@ -143,6 +144,7 @@ pub fn run(
                     disc: &stepper.disc,
                     state: &stepper.state,
                     report: &report,
+                    contact: &stepper.contact,
                 };
                 frames.observe(&view).map_err(io_err)?;
                 history.observe(&view).map_err(io_err)?;

@@ -6,7 +6,10 @@
 
 use crate::material::{self, Hyperelastic};
 use crate::mesh::generate::{self, FlatSide};
-use crate::mesh::Mesh;
+use crate::contact::detect::tributary_areas;
+use crate::contact::law::DEFAULT_BETA_EPS;
+use crate::contact::{ContactPair, InterfaceLaw, Master, RccParams, RigidMotion, RigidShape};
+use crate::mesh::{Face, Mesh};
 use crate::problem::{
     Body, Dirichlet, NodalLoad, OutputSettings, Problem, Rotation, Table, TimeSettings, Track,
 };
@@ -42,6 +45,8 @@ struct FileScenario {
     boundaries: Vec<FileBoundary>,
     #[serde(default, rename = "load")]
     loads: Vec<FileLoad>,
+    #[serde(default, rename = "contact")]
+    contacts: Vec<FileContact>,
     #[serde(default, rename = "track")]
     tracks: Vec<FileTrack>,
     #[serde(default)]
@@ -158,6 +163,60 @@ struct FileLoad {
     body: String,
     set: String,
     force: FileComponents,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileContact {
+    name: String,
+    slave: FileSetRef,
+    master: FileMaster,
+    #[serde(default)]
+    motion: Option<FileMotion>,
+    friction: f64,
+    #[serde(default)]
+    adhesion: Option<FileAdhesion>,
+    #[serde(default)]
+    detection_distance: Option<f64>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileSetRef {
+    body: String,
+    set: String,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileMaster {
+    body: Option<String>,
+    set: Option<String>,
+    rigid: Option<String>,
+    point: Option<[f64; 3]>,
+    normal: Option<[f64; 3]>,
+    center: Option<[f64; 3]>,
+    axis: Option<[f64; 3]>,
+    radius: Option<f64>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileMotion {
+    #[serde(default)]
+    displacement: Option<FileComponents>,
+    #[serde(default)]
+    rotation: Option<FileRotation>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileAdhesion {
+    w: f64,
+    cn: f64,
+    ct: f64,
+    b: f64,
+    eps: Option<f64>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -407,6 +466,18 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
         }
         loads.push(NodalLoad { nodes, total_force });
     }
+    let mut contacts = Vec::new();
+    for (i, c) in raw.contacts.iter().enumerate() {
+        contacts.push(build_contact(c, &format!("contact[{i}]"), &bodies, &body_index, &offsets, ctx)?);
+    }
+    {
+        let mut names = std::collections::BTreeSet::new();
+        for (i, c) in contacts.iter().enumerate() {
+            if !names.insert(c.name.clone()) {
+                return Err(ctx.err(format!("`contact[{i}].name`: the name {:?} is used twice; names must be unique", c.name)));
+            }
+        }
+    }
     let mut tracks = Vec::new();
     for (i, t) in raw.tracks.iter().enumerate() {
         let key = format!("track[{i}]");
@@ -453,6 +524,7 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
         loads,
         gravity,
         time,
+        contacts,
         tracks,
         output: OutputSettings { frame_interval },
     })
@@ -721,5 +793,157 @@ fn build_rotation(r: &FileRotation, key: &str, ctx: &Ctx) -> Result<Rotation, Sc
         center,
         axis: axis.map(|a| a / len),
         angle,
+    })
+}
+
+fn build_contact(
+    c: &FileContact,
+    key: &str,
+    bodies: &[Body],
+    body_index: &BTreeMap<String, usize>,
+    offsets: &[usize],
+    ctx: &Ctx,
+) -> Result<ContactPair, ScenarioError> {
+    if c.name.is_empty() || c.name.contains([',', '"', '\n', '.']) {
+        return Err(ctx.err(format!("`{key}.name` must be non-empty and hold no comma, dot or quote, got {:?}", c.name)));
+    }
+    let lookup = |k: &str, body: &str| -> Result<usize, ScenarioError> {
+        body_index.get(body).copied().ok_or_else(|| {
+            ctx.err(format!(
+                "`{k}` = {body:?} is not a body of this scenario; bodies are: {}",
+                body_index.keys().cloned().collect::<Vec<_>>().join(", ")
+            ))
+        })
+    };
+    let face_set = |k: &str, bi: usize, set: &str| -> Result<Vec<Face>, ScenarioError> {
+        let mesh = &bodies[bi].mesh;
+        match mesh.face_sets.get(set) {
+            Some(f) if !f.is_empty() => Ok(f.clone()),
+            Some(_) => Err(ctx.err(format!("`{k}` = {set:?} is an empty face set"))),
+            None => Err(ctx.err(format!(
+                "`{k}` = {set:?} is not a face set of body {:?}; its face sets are: {}",
+                bodies[bi].name,
+                mesh.face_sets.keys().cloned().collect::<Vec<_>>().join(", ")
+            ))),
+        }
+    };
+    let sb = lookup(&format!("{key}.slave.body"), &c.slave.body)?;
+    let slave_faces = face_set(&format!("{key}.slave.set"), sb, &c.slave.set)?;
+    let mesh = &bodies[sb].mesh;
+    let local_nodes = mesh.node_sets[&c.slave.set].clone();
+    let area = tributary_areas(&slave_faces, &mesh.nodes, &local_nodes);
+    let slave_nodes: Vec<usize> = local_nodes.iter().map(|n| n + offsets[sb]).collect();
+    let mean_edge = {
+        let mut sum = 0.0;
+        let mut count = 0;
+        for f in &slave_faces {
+            let ns = f.nodes();
+            for i in 0..ns.len() {
+                let (a, b) = (mesh.nodes[ns[i]], mesh.nodes[ns[(i + 1) % ns.len()]]);
+                sum += ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+                count += 1;
+            }
+        }
+        sum / count.max(1) as f64
+    };
+    let m = &c.master;
+    let master = match (&m.body, &m.rigid) {
+        (Some(body), None) => {
+            let mb = lookup(&format!("{key}.master.body"), body)?;
+            if mb == sb {
+                return Err(ctx.err(format!("`{key}`: slave and master are both on body {body:?}; self-contact is not supported, the master must be another body")));
+            }
+            let set = m.set.as_deref().ok_or_else(|| ctx.err(format!("`{key}.master` on a body needs `set` (a face set of that body)")))?;
+            if m.point.is_some() || m.normal.is_some() || m.center.is_some() || m.axis.is_some() || m.radius.is_some() {
+                return Err(ctx.err(format!("`{key}.master`: a deformable master takes only `body` and `set`")));
+            }
+            if c.motion.is_some() {
+                return Err(ctx.err(format!("`{key}.motion` applies to rigid masters only; move a deformable master with [[boundary]] conditions")));
+            }
+            let faces = face_set(&format!("{key}.master.set"), mb, set)?;
+            let off = offsets[mb];
+            Master::Faces(
+                faces
+                    .into_iter()
+                    .map(|f| match f {
+                        Face::Quad(n) => Face::Quad(n.map(|i| i + off)),
+                        Face::Tri(n) => Face::Tri(n.map(|i| i + off)),
+                    })
+                    .collect(),
+            )
+        }
+        (None, Some(kind)) => {
+            if m.set.is_some() {
+                return Err(ctx.err(format!("`{key}.master.set` goes with `body`, not with `rigid`")));
+            }
+            let need3 = |name: &str, v: Option<[f64; 3]>| -> Result<[f64; 3], ScenarioError> {
+                let v = v.ok_or_else(|| ctx.err(format!("`{key}.master` with rigid = {kind:?} needs `{name}`")))?;
+                ctx.finite3(&format!("{key}.master.{name}"), v)
+            };
+            let unit = |name: &str, v: [f64; 3]| -> Result<[f64; 3], ScenarioError> {
+                let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                if l > 0.0 { Ok(v.map(|a| a / l)) } else { Err(ctx.err(format!("`{key}.master.{name}` must be a non-zero vector"))) }
+            };
+            let radius = || -> Result<f64, ScenarioError> {
+                let r = m.radius.ok_or_else(|| ctx.err(format!("`{key}.master` with rigid = {kind:?} needs `radius` [m]")))?;
+                ctx.positive(&format!("{key}.master.radius"), r)
+            };
+            let shape = match kind.as_str() {
+                "plane" => RigidShape::Plane { point: need3("point", m.point)?, normal: unit("normal", need3("normal", m.normal)?)? },
+                "sphere" => RigidShape::Sphere { center: need3("center", m.center)?, radius: radius()? },
+                "cylinder" => RigidShape::Cylinder { point: need3("point", m.point)?, axis: unit("axis", need3("axis", m.axis)?)?, radius: radius()? },
+                other => return Err(ctx.err(format!("`{key}.master.rigid` = {other:?}; valid shapes are \"plane\", \"sphere\", \"cylinder\""))),
+            };
+            let mut translation = [Table::constant(0.0), Table::constant(0.0), Table::constant(0.0)];
+            let mut rotation = None;
+            if let Some(mo) = &c.motion {
+                if let Some(d) = &mo.displacement {
+                    for (k, (cname, t)) in [("x", &d.x), ("y", &d.y), ("z", &d.z)].into_iter().enumerate() {
+                        if let Some(t) = t {
+                            translation[k] = build_table(t, &format!("{key}.motion.displacement.{cname}"), ctx)?;
+                        }
+                    }
+                }
+                if let Some(r) = &mo.rotation {
+                    rotation = Some(build_rotation(r, &format!("{key}.motion.rotation"), ctx)?);
+                }
+            }
+            Master::Rigid { shape, motion: RigidMotion { translation, rotation } }
+        }
+        _ => return Err(ctx.err(format!("`{key}.master` needs exactly one of `body` (+ `set`: a deformable master) or `rigid` (\"plane\", \"sphere\", \"cylinder\")"))),
+    };
+    let mu = c.friction;
+    if !(mu.is_finite() && mu >= 0.0) {
+        return Err(ctx.err(format!("`{key}.friction` must be a finite number ≥ 0 (0 = frictionless), got {mu}")));
+    }
+    let adhesion = match &c.adhesion {
+        None => None,
+        Some(a) => {
+            let w = ctx.positive(&format!("{key}.adhesion.w"), a.w)?;
+            let cn = ctx.positive(&format!("{key}.adhesion.cn"), a.cn)?;
+            if !(a.ct.is_finite() && a.ct >= 0.0) {
+                return Err(ctx.err(format!("`{key}.adhesion.ct` must be a finite number ≥ 0 [N/m³], got {}", a.ct)));
+            }
+            if !(a.b.is_finite() && a.b >= 0.0) {
+                return Err(ctx.err(format!("`{key}.adhesion.b` must be a finite number ≥ 0 [N·s/m] (0 = rate-independent), got {}", a.b)));
+            }
+            let eps = a.eps.unwrap_or(DEFAULT_BETA_EPS);
+            if !(eps > 0.0 && eps < 1.0) {
+                return Err(ctx.err(format!("`{key}.adhesion.eps` must be in (0, 1), got {eps}")));
+            }
+            Some(RccParams { w, cn, ct: a.ct, b: a.b, eps })
+        }
+    };
+    let detection_distance = match c.detection_distance {
+        Some(d) => ctx.positive(&format!("{key}.detection_distance"), d)?,
+        None => 0.5 * mean_edge,
+    };
+    Ok(ContactPair {
+        name: c.name.clone(),
+        slave_nodes,
+        slave_area: area,
+        master,
+        law: InterfaceLaw { mu, adhesion },
+        detection_distance,
     })
 }

@@ -8,6 +8,9 @@
 //! The quasi-static mode drops M and A: G = F_int(u₁) − F_ext¹ − R₁, K̄ = K.
 
 use crate::assembly::{BadElement, Discretisation};
+use crate::contact::detect::{detect, ContactPoint};
+use crate::contact::law::{BondState, ContactState, PointSolution};
+use crate::contact::solve::{delassus, gauss_seidel};
 use crate::linalg::{LinalgError, SparseCholesky};
 use crate::problem::Problem;
 use std::sync::Arc;
@@ -66,8 +69,35 @@ pub struct StepReport {
     pub kinetic: f64,
     /// Strain energy [J].
     pub internal: f64,
-    /// Work done on the bodies since t = 0 by loads, gravity and supports [J].
+    /// Work done on the bodies since t = 0 by loads, gravity, supports and contact [J].
     pub external_work: f64,
+    /// Gauss-Seidel sweeps over contact points, summed over the Newton iterations.
+    pub contact_sweeps: usize,
+    /// Contact candidates of the step.
+    pub contact_points: usize,
+}
+
+/// The contact state of one slave node, committed at the end of every step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NodeContact {
+    /// Intensity of adhesion β ∈ [0, 1].
+    pub beta: f64,
+    /// Bond stretch u_t in global axes [m].
+    pub ut: [f64; 3],
+    /// Dry force r̄ in the local frame (t₁, t₂, n) [N].
+    pub r_dry: [f64; 3],
+    /// Adhesive force r̃ in the local frame [N].
+    pub r_adh: [f64; 3],
+    /// Total contact force on the slave node in global axes [N].
+    pub force: [f64; 3],
+    /// Gap at the end of the step x_n [m] (NaN when the node is not a candidate).
+    pub gap: f64,
+    /// Slip increment over the step (t₁, t₂) [m].
+    pub slip: [f64; 2],
+    /// 0 not a candidate, 1 apart, 2 stick, 3 slide.
+    pub state: i32,
+    /// Tangent axes T₁, T₂ of the local frame (global components).
+    pub tangent_axes: [[f64; 3]; 2],
 }
 
 /// The state of the bodies.
@@ -103,6 +133,8 @@ pub struct Stepper {
     f_int0: Vec<f64>,
     external_work: f64,
     last_internal: f64,
+    /// Committed contact state per pair and slave node.
+    pub contact: Vec<Vec<NodeContact>>,
 }
 
 struct Attempt {
@@ -114,6 +146,9 @@ struct Attempt {
     residual: f64,
     internal: f64,
     work: f64,
+    points: Vec<ContactPoint>,
+    solutions: Vec<PointSolution>,
+    sweeps: usize,
 }
 
 impl Stepper {
@@ -191,7 +226,14 @@ impl Stepper {
             f_int0: vec![0.0; n],
             external_work: 0.0,
             last_internal: 0.0,
+            contact: Vec::new(),
         };
+        s.contact = s
+            .problem
+            .contacts
+            .iter()
+            .map(|c| vec![NodeContact { gap: f64::NAN, ..Default::default() }; c.slave_nodes.len()])
+            .collect();
         s.apply_dirichlet_to_state();
         s.f_ext0 = s.external_force(0.0);
         let a = s.disc.assemble(&s.state.u, false);
@@ -260,6 +302,8 @@ impl Stepper {
             }
             match self.attempt(dt) {
                 Ok(a) => {
+                    self.commit_contact(&a.points, &a.solutions);
+                    let (contact_sweeps, contact_points) = (a.sweeps, a.points.len());
                     self.commit(a.u, a.v, dt);
                     self.external_work += a.work;
                     self.last_internal = a.internal;
@@ -289,6 +333,8 @@ impl Stepper {
                         kinetic,
                         internal: a.internal,
                         external_work: self.external_work,
+                        contact_sweeps,
+                        contact_points,
                     });
                 }
                 Err(reason) => {
@@ -304,6 +350,47 @@ impl Stepper {
                 }
             }
         }
+    }
+
+    fn commit_contact(&mut self, points: &[ContactPoint], sols: &[PointSolution]) {
+        for nodes in &mut self.contact {
+            for n in nodes.iter_mut() {
+                *n = NodeContact { gap: f64::NAN, ..Default::default() };
+            }
+        }
+        for (pt, sol) in points.iter().zip(sols) {
+            let f = &pt.frame;
+            let r = sol.r();
+            let global = |v: [f64; 3]| -> [f64; 3] { std::array::from_fn(|k| v[0] * f[0][k] + v[1] * f[1][k] + v[2] * f[2][k]) };
+            self.contact[pt.pair][pt.local] = NodeContact {
+                beta: sol.beta,
+                ut: global([sol.ut[0], sol.ut[1], 0.0]),
+                r_dry: sol.r_dry,
+                r_adh: sol.r_adh,
+                force: global(r),
+                gap: sol.x[2],
+                slip: [sol.x[0], sol.x[1]],
+                state: match sol.state {
+                    ContactState::Apart => 1,
+                    ContactState::Stick => 2,
+                    ContactState::Slide => 3,
+                },
+                tangent_axes: [f[0], f[1]],
+            };
+        }
+    }
+
+    /// Committed bond state of each contact point, in its local frame.
+    fn bonds_at_start(&self, points: &[ContactPoint]) -> Vec<BondState> {
+        points
+            .iter()
+            .map(|pt| {
+                let c = &self.contact[pt.pair][pt.local];
+                let f = &pt.frame;
+                let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+                BondState { beta: c.beta, ut: [dot(c.ut, f[0]), dot(c.ut, f[1])] }
+            })
+            .collect()
     }
 
     fn commit(&mut self, u: Vec<f64>, v: Vec<f64>, dt: f64) {
@@ -325,6 +412,18 @@ impl Stepper {
         let u0 = &self.state.u;
         let v0 = &self.state.v;
         let f_ext1 = self.external_force(t1);
+        let points = if self.problem.contacts.is_empty() {
+            Vec::new()
+        } else {
+            detect(&self.problem.contacts, &self.disc.reference, u0, self.state.t, t1)
+        };
+        let bond0 = self.bonds_at_start(&points);
+        let laws: Vec<_> = self.problem.contacts.iter().map(|c| c.law).collect();
+        let mut r_contact: Vec<[f64; 3]> = vec![[0.0; 3]; points.len()];
+        let mut r_dry: Vec<[f64; 3]> = vec![[0.0; 3]; points.len()];
+        let mut solutions: Vec<PointSolution> = Vec::new();
+        let mut sweeps = 0;
+        let mut contact_force = vec![0.0; n];
         // Predictor: constant velocity for dynamics, last state for quasi-static.
         let mut u: Vec<f64> = if qs {
             u0.clone()
@@ -395,15 +494,20 @@ impl Stepper {
                     }
                 }
             }
+            // g is G(u) without contact (what the Newton correction solves against); the
+            // convergence check uses G(u) − Hᵀr.
+            let mut g_check: Vec<f64> = (0..n).map(|i| g[i] - contact_force[i]).collect();
             let reactions: Vec<f64> = (0..n)
-                .map(|i| if self.constrained[i] { g[i] } else { 0.0 })
+                .map(|i| if self.constrained[i] { g_check[i] } else { 0.0 })
                 .collect();
             for i in 0..n {
                 if self.constrained[i] {
                     g[i] = 0.0;
+                    g_check[i] = 0.0;
                 }
             }
-            let gnorm = norm(&g);
+            scale = scale.max(norm(&contact_force));
+            let gnorm = norm(&g_check);
             if !gnorm.is_finite() {
                 return Err(format!(
                     "the residual is not finite at Newton iteration {iter}"
@@ -427,7 +531,7 @@ impl Stepper {
                     } else {
                         (1.0 - xi) * self.f_ext0[i] + xi * f_ext1[i]
                     };
-                    work += du[i] * (f_applied + reactions[i]);
+                    work += du[i] * (f_applied + reactions[i] + contact_force[i]);
                 }
                 return Ok(Attempt {
                     v: if qs {
@@ -442,6 +546,9 @@ impl Stepper {
                     residual: rel,
                     internal: asm.energy,
                     work,
+                    points,
+                    solutions,
+                    sweeps,
                 });
             }
             if iter == ts.max_newton {
@@ -472,6 +579,44 @@ impl Stepper {
                 .map_err(|e| format!("{e} (Newton iteration {iter})"))?;
             let mut du: Vec<f64> = g.iter().map(|x| -x).collect();
             self.chol.solve_in_place(&mut du);
+            if !points.is_empty() {
+                // Reduced contact system: x = x(u) + H Δu_free + W r.
+                let del = delassus(&points, &mut self.chol, &self.constrained);
+                let x_free: Vec<[f64; 3]> = points
+                    .iter()
+                    .map(|pt| {
+                        let x = pt.local_x(&self.disc.reference, &u);
+                        let h = pt.apply_h(&du);
+                        [x[0] + h[0], x[1] + h[1], x[2] + h[2]]
+                    })
+                    .collect();
+                let sol = gauss_seidel(&points, &laws, &bond0, dt, &del, &x_free, &r_contact, &r_dry, 1e-10, 500);
+                sweeps += sol.sweeps;
+                if !sol.converged {
+                    return Err(format!("the contact solve did not settle in {} Gauss-Seidel sweeps (Newton iteration {iter})", sol.sweeps));
+                }
+                contact_force.iter_mut().for_each(|v| *v = 0.0);
+                for (p, ps) in sol.points.iter().enumerate() {
+                    let r = ps.r();
+                    r_contact[p] = r;
+                    r_dry[p] = ps.r_dry;
+                    points[p].add_ht(r, &mut contact_force);
+                    let zc = &del.z[3 * p * n..(3 * p + 3) * n];
+                    for c in 0..3 {
+                        if r[c] != 0.0 {
+                            for i in 0..n {
+                                du[i] += zc[c * n + i] * r[c];
+                            }
+                        }
+                    }
+                }
+                for i in 0..n {
+                    if self.constrained[i] {
+                        contact_force[i] = 0.0;
+                    }
+                }
+                solutions = sol.points;
+            }
             for i in 0..n {
                 u[i] += du[i];
             }

@@ -35,6 +35,7 @@ pub fn one_body(mesh: Mesh, material: Arc<dyn Hyperelastic>, density: f64, time:
         loads: vec![],
         gravity: [0.0; 3],
         time,
+        contacts: vec![],
         tracks: vec![],
         output: OutputSettings { frame_interval: 0.0 },
     }

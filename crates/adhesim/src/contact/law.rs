@@ -1505,6 +1505,7 @@ mod tests {
 
     #[test]
     fn beta_stays_in_unit_interval() {
+        // β₁ ∈ [0, 1], lies between β₀ and β∞ = min(1, w/E), and is below ε only while forming.
         let mut rng = Rng(11);
         for _ in 0..10_000 {
             let p = RccParams {
@@ -1518,16 +1519,31 @@ mod tests {
                 },
                 eps: DEFAULT_BETA_EPS,
             };
-            let b = beta_update(
-                rng.uniform(-0.5, 1.5),
-                10f64.powf(rng.uniform(-8.0, 0.0)),
-                &p,
-                rng.uniform(-1e-3, 1e-3),
-                [rng.uniform(-1e-3, 1e-3), rng.uniform(-1e-3, 1e-3)],
-            );
+            let beta0 = rng.uniform(0.0, 1.0);
+            let xn = rng.uniform(-1e-3, 1e-3);
+            let ut = [rng.uniform(-1e-3, 1e-3), rng.uniform(-1e-3, 1e-3)];
+            let b = beta_update(beta0, 10f64.powf(rng.uniform(-8.0, 0.0)), &p, xn, ut);
             assert!((0.0..=1.0).contains(&b), "{b}");
-            assert!(b == 0.0 || b >= p.eps || b > 0.0);
+            let e = stretch_energy(&p, xn, ut);
+            let binf = if e > 0.0 { (p.w / e).min(1.0) } else { 1.0 };
+            if b > 0.0 {
+                let (lo, hi) = (beta0.min(binf), beta0.max(binf));
+                assert!(
+                    b >= lo * (1.0 - 1e-12) && b <= hi * (1.0 + 1e-12),
+                    "{b} {beta0} {binf}"
+                );
+                assert!(b >= p.eps || binf >= p.eps, "{b} below ε and not forming");
+            } else {
+                assert!(
+                    binf < p.eps || p.w == 0.0 || b == beta0,
+                    "{b} {beta0} {binf}"
+                );
+            }
         }
+        // Out-of-range β₀ is clamped.
+        let p = paper_rcc();
+        assert_eq!(beta_update(1.5, 0.0, &p, 0.0, [0.0; 2]), 1.0);
+        assert_eq!(beta_update(-0.5, 0.0, &p, 0.0, [0.0; 2]), 0.0);
     }
 
     #[test]

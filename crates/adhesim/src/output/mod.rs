@@ -3,13 +3,13 @@
 
 pub mod atomic;
 pub mod csv;
-// pub mod plot;
+pub mod plot;
 pub mod vtk;
 
 use crate::assembly::Discretisation;
 use crate::element::{element_cauchy_stress, von_mises};
 use crate::problem::Problem;
-use crate::time::{State, StepReport};
+use crate::time::{NodeContact, State, StepReport};
 use std::io;
 use std::path::{Path, PathBuf};
 
@@ -24,6 +24,8 @@ pub struct StepView<'a> {
     pub state: &'a State,
     /// What the step did.
     pub report: &'a StepReport,
+    /// Committed contact state per pair and slave node.
+    pub contact: &'a [Vec<NodeContact>],
 }
 
 /// Records a run.
@@ -159,12 +161,81 @@ impl Observer for FrameWriter {
                     .with_cell_data("J", vtk::FieldData::Scalar(&f.jac))
             })
             .collect();
+        let surfaces: Vec<ContactFrame> = view
+            .problem
+            .contacts
+            .iter()
+            .zip(view.contact)
+            .map(|(pair, nodes)| contact_frame(pair, nodes, view))
+            .collect();
+        let mut pieces = pieces;
+        for c in &surfaces {
+            pieces.push(
+                vtk::Piece::new(&c.points)
+                    .with_cells(vtk::CellKind::Vertex, &c.vertices)
+                    .with_point_data("beta", vtk::FieldData::Scalar(&c.beta))
+                    .with_point_data("rn", vtk::FieldData::Scalar(&c.rn))
+                    .with_point_data("rn_dry", vtk::FieldData::Scalar(&c.rn_dry))
+                    .with_point_data("rn_adh", vtk::FieldData::Scalar(&c.rn_adh))
+                    .with_point_data("rt", vtk::FieldData::Vector(&c.rt))
+                    .with_point_data("rt_adh", vtk::FieldData::Vector(&c.rt_adh))
+                    .with_point_data("contact_force", vtk::FieldData::Vector(&c.force))
+                    .with_point_data("gap", vtk::FieldData::Scalar(&c.gap))
+                    .with_point_data("slip", vtk::FieldData::Scalar(&c.slip))
+                    .with_point_data("ut", vtk::FieldData::Vector(&c.ut))
+                    .with_point_data("state", vtk::FieldData::Int(&c.state)),
+            );
+        }
         let rel = format!("vtu/{}_{:05}.vtu", self.name, self.frames);
         vtk::write_vtu(&self.dir.join(&rel), &pieces)?;
         self.pvd.push(t, &rel)?;
         self.frames += 1;
         Ok(())
     }
+}
+
+/// Point data of one contact surface.
+struct ContactFrame {
+    points: Vec<[f64; 3]>,
+    vertices: Vec<usize>,
+    beta: Vec<f64>,
+    rn: Vec<f64>,
+    rn_dry: Vec<f64>,
+    rn_adh: Vec<f64>,
+    rt: Vec<[f64; 3]>,
+    rt_adh: Vec<[f64; 3]>,
+    force: Vec<[f64; 3]>,
+    gap: Vec<f64>,
+    slip: Vec<f64>,
+    ut: Vec<[f64; 3]>,
+    state: Vec<i32>,
+}
+
+fn contact_frame(pair: &crate::contact::ContactPair, nodes: &[NodeContact], view: &StepView) -> ContactFrame {
+    let u = &view.state.u;
+    let x = &view.disc.reference;
+    let mut f = ContactFrame {
+        points: pair.slave_nodes.iter().map(|&n| std::array::from_fn(|k| x[n][k] + u[3 * n + k])).collect(),
+        vertices: (0..pair.slave_nodes.len()).collect(),
+        beta: nodes.iter().map(|c| c.beta).collect(),
+        rn: nodes.iter().map(|c| c.r_dry[2] + c.r_adh[2]).collect(),
+        rn_dry: nodes.iter().map(|c| c.r_dry[2]).collect(),
+        rn_adh: nodes.iter().map(|c| c.r_adh[2]).collect(),
+        rt: Vec::new(),
+        rt_adh: Vec::new(),
+        force: nodes.iter().map(|c| c.force).collect(),
+        gap: nodes.iter().map(|c| c.gap).collect(),
+        slip: nodes.iter().map(|c| (c.slip[0].powi(2) + c.slip[1].powi(2)).sqrt()).collect(),
+        ut: nodes.iter().map(|c| c.ut).collect(),
+        state: nodes.iter().map(|c| c.state).collect(),
+    };
+    for c in nodes {
+        let t = c.tangent_axes;
+        let g = |v: [f64; 2]| -> [f64; 3] { std::array::from_fn(|k| v[0] * t[0][k] + v[1] * t[1][k]) };
+        f.rt.push(g([c.r_dry[0] + c.r_adh[0], c.r_dry[1] + c.r_adh[1]]));
+        f.rt_adh.push(g([c.r_adh[0], c.r_adh[1]]));
+    }
+    f
 }
 
 /// Writes `history.csv`: one row per committed step.
@@ -189,12 +260,36 @@ pub fn history_columns(problem: &Problem) -> Vec<String> {
     .iter()
     .map(|s| s.to_string())
     .collect();
+    c.push("contact_sweeps".into());
+    c.push("contact_points".into());
+    for pair in &problem.contacts {
+        for f in ["fx", "fy", "fz", "fn", "fn_adh", "ft", "ft_adh", "bonded"] {
+            c.push(format!("{}.{f}", pair.name));
+        }
+    }
     for tr in &problem.tracks {
         for f in ["ux", "uy", "uz", "vx", "vy", "vz"] {
             c.push(format!("{}.{f}", tr.name));
         }
+        if track_contact(problem, tr.node).is_some() {
+            for f in CONTACT_TRACK_FIELDS {
+                c.push(format!("{}.{f}", tr.name));
+            }
+        }
     }
     c
+}
+
+/// Contact fields written for a tracked node that is a slave node of a pair.
+const CONTACT_TRACK_FIELDS: [&str; 9] = ["beta", "rn", "rn_dry", "rn_adh", "rt", "rt_adh", "gap", "slip", "state"];
+
+/// (pair, index within the pair) of a tracked node that is a slave node.
+fn track_contact(problem: &Problem, node: usize) -> Option<(usize, usize)> {
+    problem
+        .contacts
+        .iter()
+        .enumerate()
+        .find_map(|(p, c)| c.slave_nodes.iter().position(|&n| n == node).map(|i| (p, i)))
 }
 
 impl HistoryObserver {
@@ -221,10 +316,44 @@ impl Observer for HistoryObserver {
             r.external_work,
             r.kinetic + r.internal - r.external_work,
         ];
+        row.push(r.contact_sweeps as f64);
+        row.push(r.contact_points as f64);
+        for nodes in view.contact {
+            let mut total = [0.0; 3];
+            let (mut fn_, mut fn_adh, mut ft, mut ft_adh, mut bonded) = (0.0, 0.0, 0.0, 0.0, 0.0);
+            for c in nodes {
+                for k in 0..3 {
+                    total[k] += c.force[k];
+                }
+                fn_ += c.r_dry[2] + c.r_adh[2];
+                fn_adh += c.r_adh[2];
+                ft += (c.r_dry[0] + c.r_adh[0]).hypot(c.r_dry[1] + c.r_adh[1]);
+                ft_adh += c.r_adh[0].hypot(c.r_adh[1]);
+                if c.beta > 0.0 {
+                    bonded += 1.0;
+                }
+            }
+            row.extend_from_slice(&total);
+            row.extend_from_slice(&[fn_, fn_adh, ft, ft_adh, bonded]);
+        }
         for tr in &view.problem.tracks {
             let n = tr.node;
             row.extend_from_slice(&view.state.u[3 * n..3 * n + 3]);
             row.extend_from_slice(&view.state.v[3 * n..3 * n + 3]);
+            if let Some((p, i)) = track_contact(view.problem, n) {
+                let c = &view.contact[p][i];
+                row.extend_from_slice(&[
+                    c.beta,
+                    c.r_dry[2] + c.r_adh[2],
+                    c.r_dry[2],
+                    c.r_adh[2],
+                    (c.r_dry[0] + c.r_adh[0]).hypot(c.r_dry[1] + c.r_adh[1]),
+                    c.r_adh[0].hypot(c.r_adh[1]),
+                    c.gap,
+                    c.slip[0].hypot(c.slip[1]),
+                    c.state as f64,
+                ]);
+            }
         }
         self.writer.append(&row)
     }

@@ -1,0 +1,918 @@
+//! Performance benchmark of the solver core on Blatz-Ko hex meshes of the unit cube:
+//!
+//! 1. assembly throughput (element tangent + residual + scatter) on 1 and 2 threads, and a
+//!    microbenchmark of one hex8 element response;
+//! 2. METIS ordering, faer symbolic analysis and faer numeric Cholesky factorisation of
+//!    K̄ = K + M/Δt² on 1 and 2 threads;
+//! 3. optionally, the numeric factorisation of the very same matrix by SuiteSparse CHOLMOD
+//!    (through the driver in bench/cholmod), with its own METIS ordering and with the
+//!    elimination order used by faer;
+//! 4. Newton iterations per step of a dynamic compression of a 20³ block.
+//!
+//! Every timing is repeated (after one warm-up run) and reported as a median.
+//!
+//! Run `cargo run --release --example bench_core -- --help` for the options, or
+//! `bench/run.sh` for the complete comparison with CHOLMOD.
+
+use adhesim::assembly::Discretisation;
+use adhesim::element::{element_response, hex8_geometry};
+use adhesim::linalg::{metis_dof_ordering, BlockPattern, SparseCholesky};
+use adhesim::material::{BlatzKo, Hyperelastic};
+use adhesim::mesh::generate;
+use adhesim::problem::{Body, Dirichlet, OutputSettings, Problem, Table, TimeSettings};
+use adhesim::time::Stepper;
+use faer::perm::PermRef;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw,
+    SymmetricOrdering,
+};
+use faer::sparse::SymbolicSparseColMat;
+use faer::Side;
+use std::collections::BTreeMap;
+use std::f64::consts::PI;
+use std::fmt::Write as _;
+use std::hint::black_box;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Small-strain shear modulus of the Blatz-Ko material [Pa].
+const SHEAR_MODULUS: f64 = 1e6;
+/// Density used for the mass matrix [kg/m³].
+const DENSITY: f64 = 1000.0;
+/// Time step of K̄ = K + M/Δt² [s].
+const MATRIX_DT: f64 = 1e-3;
+
+const USAGE: &str = "\
+bench_core: performance benchmark of adhesim's assembly and sparse Cholesky
+
+Options:
+  --sizes 20,30,40          cube meshes n³ to measure (default 20,30,40)
+  --reps N                  timed repetitions per measurement, after one warm-up (default 5)
+  --threads 1,2             thread counts (default 1,2)
+  --cholmod PATH            CHOLMOD driver (bench/cholmod/cholmod_bench); omit to skip
+  --cholmod-orderings LIST  orderings given to the driver (default metis,given)
+  --cholmod-modes LIST      CHOLMOD modes (default supernodal,simplicial)
+  --simplicial-max-gflop X  skip CHOLMOD simplicial above this flop count (default 10)
+  --data-dir DIR            where matrices are exported (default bench/data)
+  --keep-data               keep the exported matrices
+  --micro-iters N           element calls per microbenchmark repetition (default 20000)
+  --dynamic-size N          mesh of the dynamic case (default 20; 0 skips it)
+  --dynamic-steps N         steps of the dynamic case (default 20)
+  --results PATH            also write the report (markdown) to PATH
+";
+
+struct Config {
+    sizes: Vec<usize>,
+    reps: usize,
+    threads: Vec<usize>,
+    cholmod: Option<PathBuf>,
+    cholmod_orderings: String,
+    cholmod_modes: String,
+    simplicial_max_gflop: f64,
+    data_dir: PathBuf,
+    keep_data: bool,
+    micro_iters: usize,
+    dynamic_size: usize,
+    dynamic_steps: usize,
+    results: Option<PathBuf>,
+}
+
+fn parse_list(s: &str) -> Vec<usize> {
+    s.split(',')
+        .map(|x| {
+            x.trim()
+                .parse()
+                .unwrap_or_else(|_| fail(&format!("not a number: {x}")))
+        })
+        .collect()
+}
+
+fn fail(msg: &str) -> ! {
+    eprintln!("bench_core: {msg}\n\n{USAGE}");
+    std::process::exit(2)
+}
+
+fn parse_args() -> Config {
+    let bench_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../bench");
+    let mut c = Config {
+        sizes: vec![20, 30, 40],
+        reps: 5,
+        threads: vec![1, 2],
+        cholmod: None,
+        cholmod_orderings: "metis,given".into(),
+        cholmod_modes: "supernodal,simplicial".into(),
+        simplicial_max_gflop: 10.0,
+        data_dir: bench_dir.join("data"),
+        keep_data: false,
+        micro_iters: 20_000,
+        dynamic_size: 20,
+        dynamic_steps: 20,
+        results: None,
+    };
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut i = 0;
+    while i < args.len() {
+        let flag = args[i].as_str();
+        if flag == "--help" || flag == "-h" {
+            print!("{USAGE}");
+            std::process::exit(0);
+        }
+        if flag == "--keep-data" {
+            c.keep_data = true;
+            i += 1;
+            continue;
+        }
+        let value = args
+            .get(i + 1)
+            .unwrap_or_else(|| fail(&format!("{flag} needs a value")))
+            .clone();
+        let number = |v: &str| -> usize {
+            v.parse()
+                .unwrap_or_else(|_| fail(&format!("{flag}: not a number: {v}")))
+        };
+        match flag {
+            "--sizes" => c.sizes = parse_list(&value),
+            "--reps" => c.reps = number(&value).max(1),
+            "--threads" => c.threads = parse_list(&value),
+            "--cholmod" => c.cholmod = Some(PathBuf::from(value)),
+            "--cholmod-orderings" => c.cholmod_orderings = value,
+            "--cholmod-modes" => c.cholmod_modes = value,
+            "--simplicial-max-gflop" => {
+                c.simplicial_max_gflop = value
+                    .parse()
+                    .unwrap_or_else(|_| fail("--simplicial-max-gflop: not a number"))
+            }
+            "--data-dir" => c.data_dir = PathBuf::from(value),
+            "--micro-iters" => c.micro_iters = number(&value).max(1),
+            "--dynamic-size" => c.dynamic_size = number(&value),
+            "--dynamic-steps" => c.dynamic_steps = number(&value).max(1),
+            "--results" => c.results = Some(PathBuf::from(value)),
+            _ => fail(&format!("unknown option {flag}")),
+        }
+        i += 2;
+    }
+    if c.threads.iter().any(|&t| t == 0) {
+        fail("thread counts must be at least 1");
+    }
+    c
+}
+
+/// Repeated timings [s] of one measurement.
+#[derive(Clone, Debug, Default)]
+struct Samples(Vec<f64>);
+
+impl Samples {
+    fn sorted(&self) -> Vec<f64> {
+        let mut v = self.0.clone();
+        v.sort_by(f64::total_cmp);
+        v
+    }
+    fn median(&self) -> f64 {
+        let v = self.sorted();
+        let n = v.len();
+        if n == 0 {
+            f64::NAN
+        } else if n % 2 == 1 {
+            v[n / 2]
+        } else {
+            0.5 * (v[n / 2 - 1] + v[n / 2])
+        }
+    }
+    fn min(&self) -> f64 {
+        self.sorted().first().copied().unwrap_or(f64::NAN)
+    }
+    fn max(&self) -> f64 {
+        self.sorted().last().copied().unwrap_or(f64::NAN)
+    }
+}
+
+/// One warm-up call, then `reps` timed calls.
+fn time_reps(reps: usize, mut f: impl FnMut()) -> Samples {
+    f();
+    Samples(
+        (0..reps)
+            .map(|_| {
+                let t0 = Instant::now();
+                f();
+                t0.elapsed().as_secs_f64()
+            })
+            .collect(),
+    )
+}
+
+fn with_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool")
+        .install(f)
+}
+
+/// Smooth displacement field: 5 % stretch along x with lateral contraction, shears of
+/// 1–3 %, and a bubble so that no two elements see the same deformation.
+fn displacement(x: [f64; 3]) -> [f64; 3] {
+    let s = (PI * x[0]).sin() * (PI * x[1]).sin() * (PI * x[2]).sin();
+    [
+        0.05 * x[0] + 0.03 * x[1] + 0.01 * s,
+        -0.0125 * x[1] + 0.02 * x[2] + 0.005 * s,
+        0.01 * x[0] - 0.0125 * x[2] - 0.008 * s,
+    ]
+}
+
+fn material() -> Arc<dyn Hyperelastic> {
+    Arc::new(BlatzKo::new(SHEAR_MODULUS))
+}
+
+// ---------------------------------------------------------------------------------------
+// Measurements
+// ---------------------------------------------------------------------------------------
+
+struct AssemblyResult {
+    threads: usize,
+    with_tangent: Samples,
+    force_only: Samples,
+}
+
+struct FactorStats {
+    supernodal: bool,
+    supernodes: usize,
+    largest_supernode: usize,
+    stored: usize,
+    flops: f64,
+}
+
+struct NumericResult {
+    threads: usize,
+    factorise: Samples,
+    solve_error: f64,
+}
+
+#[derive(Default)]
+struct CholmodRun {
+    info: BTreeMap<String, String>,
+    results: Vec<BTreeMap<String, String>>,
+    notes: Vec<String>,
+}
+
+impl CholmodRun {
+    fn find(&self, ordering: &str, mode: &str, threads: usize) -> Option<&BTreeMap<String, String>> {
+        self.results.iter().find(|r| {
+            r.get("ordering").map(String::as_str) == Some(ordering)
+                && r.get("mode").map(String::as_str) == Some(mode)
+                && r.get("threads").and_then(|t| t.parse().ok()) == Some(threads)
+        })
+    }
+    fn any(&self, ordering: &str, mode: &str) -> Option<&BTreeMap<String, String>> {
+        self.results.iter().find(|r| {
+            r.get("ordering").map(String::as_str) == Some(ordering)
+                && r.get("mode").map(String::as_str) == Some(mode)
+        })
+    }
+}
+
+struct SizeResult {
+    n: usize,
+    elements: usize,
+    dofs: usize,
+    nnz: usize,
+    min_j: f64,
+    assembly: Vec<AssemblyResult>,
+    metis: Samples,
+    symbolic: Samples,
+    analyse: Samples,
+    stats: FactorStats,
+    numeric: Vec<NumericResult>,
+    cholmod: Option<CholmodRun>,
+}
+
+fn factor_stats(s: &SymbolicCholesky<usize>) -> FactorStats {
+    match s.raw() {
+        SymbolicCholeskyRaw::Supernodal(sn) => {
+            let begin = sn.supernode_begin();
+            let end = sn.supernode_end();
+            let val_ptr = sn.col_ptr_for_val();
+            let mut flops = 0.0;
+            let mut largest = 0;
+            for k in 0..sn.n_supernodes() {
+                let ncols = end[k] - begin[k];
+                let nrows = (val_ptr[k + 1] - val_ptr[k]) / ncols;
+                largest = largest.max(ncols);
+                for j in 0..ncols {
+                    let c = (nrows - j) as f64;
+                    flops += c * c;
+                }
+            }
+            FactorStats {
+                supernodal: true,
+                supernodes: sn.n_supernodes(),
+                largest_supernode: largest,
+                stored: sn.len_val(),
+                flops,
+            }
+        }
+        SymbolicCholeskyRaw::Simplicial(sp) => {
+            let cp = sp.col_ptr();
+            let flops = cp.windows(2).map(|w| ((w[1] - w[0]) as f64).powi(2)).sum();
+            FactorStats {
+                supernodal: false,
+                supernodes: 0,
+                largest_supernode: 0,
+                stored: sp.len_val(),
+                flops,
+            }
+        }
+    }
+}
+
+fn symbolic_with(
+    sym: &SymbolicSparseColMat<usize>,
+    fwd: &[usize],
+    inv: &[usize],
+) -> SymbolicCholesky<usize> {
+    let n = sym.nrows();
+    let perm = PermRef::new_checked(fwd, inv, n);
+    factorize_symbolic_cholesky(
+        sym.as_ref(),
+        Side::Upper,
+        SymmetricOrdering::Custom(perm),
+        CholeskySymbolicParams::default(),
+    )
+    .expect("symbolic factorisation")
+}
+
+/// Writes the upper-triangle CSC matrix and an elimination order in the ADHKBAR1 format
+/// read by bench/cholmod/cholmod_bench.
+fn export_matrix(path: &Path, p: &BlockPattern, values: &[f64], perm: &[usize]) -> std::io::Result<()> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    let mut w = std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(path)?);
+    w.write_all(b"ADHKBAR1")?;
+    for h in [p.dim() as u64, p.nnz() as u64, 1] {
+        w.write_all(&h.to_le_bytes())?;
+    }
+    for &x in p.col_ptr.iter().chain(&p.row_idx) {
+        w.write_all(&(x as u64).to_le_bytes())?;
+    }
+    for &v in values {
+        w.write_all(&v.to_le_bytes())?;
+    }
+    for &x in perm {
+        w.write_all(&(x as u64).to_le_bytes())?;
+    }
+    w.flush()
+}
+
+/// Splits `kind key=value key="quoted value" ...` into the kind and its fields.
+fn parse_driver_line(line: &str) -> Option<(String, BTreeMap<String, String>)> {
+    let mut chars = line.trim().chars().peekable();
+    let kind: String = chars.by_ref().take_while(|c| !c.is_whitespace()).collect();
+    if kind.is_empty() {
+        return None;
+    }
+    let mut fields = BTreeMap::new();
+    loop {
+        while chars.peek().is_some_and(|c| c.is_whitespace()) {
+            chars.next();
+        }
+        let key: String = chars.by_ref().take_while(|&c| c != '=').collect();
+        if key.is_empty() {
+            break;
+        }
+        let value: String = if chars.peek() == Some(&'"') {
+            chars.next();
+            chars.by_ref().take_while(|&c| c != '"').collect()
+        } else {
+            chars.by_ref().take_while(|c| !c.is_whitespace()).collect()
+        };
+        fields.insert(key.trim().to_string(), value);
+    }
+    Some((kind, fields))
+}
+
+fn run_cholmod(cfg: &Config, driver: &Path, matrix: &Path) -> CholmodRun {
+    let threads: Vec<String> = cfg.threads.iter().map(|t| t.to_string()).collect();
+    let output = Command::new(driver)
+        .arg(matrix)
+        .args(["--reps", &cfg.reps.to_string()])
+        .args(["--threads", &threads.join(",")])
+        .args(["--orderings", &cfg.cholmod_orderings])
+        .args(["--modes", &cfg.cholmod_modes])
+        .args(["--simplicial-max-gflop", &cfg.simplicial_max_gflop.to_string()])
+        .output()
+        .unwrap_or_else(|e| fail(&format!("cannot run {}: {e}", driver.display())));
+    if !output.status.success() {
+        eprintln!(
+            "bench_core: CHOLMOD driver failed: {}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+    }
+    let mut run = CholmodRun::default();
+    for line in String::from_utf8_lossy(&output.stdout).lines() {
+        match parse_driver_line(line) {
+            Some((kind, fields)) if kind == "info" => run.info = fields,
+            Some((kind, fields)) if kind == "result" => run.results.push(fields),
+            Some(_) => run.notes.push(line.to_string()),
+            None => {}
+        }
+    }
+    run
+}
+
+fn bench_size(cfg: &Config, n: usize) -> SizeResult {
+    let progress = |what: &str| eprintln!("[{n}³] {what}");
+    let mesh = generate::block([1.0; 3], [n; 3]);
+    let disc = Discretisation::new(&[(&mesh, material())]).expect("valid mesh");
+    let u: Vec<f64> = disc.reference.iter().flat_map(|&x| displacement(x)).collect();
+    let pattern = &disc.pattern;
+
+    progress("assembly");
+    let mut assembly = Vec::new();
+    let mut reference = None;
+    for &t in &cfg.threads {
+        let (with_tangent, force_only, asm) = with_threads(t, || {
+            let with_tangent = time_reps(cfg.reps, || {
+                black_box(disc.assemble(black_box(&u), true));
+            });
+            let force_only = time_reps(cfg.reps, || {
+                black_box(disc.assemble(black_box(&u), false));
+            });
+            (with_tangent, force_only, disc.assemble(&u, true))
+        });
+        assembly.push(AssemblyResult {
+            threads: t,
+            with_tangent,
+            force_only,
+        });
+        reference.get_or_insert(asm);
+    }
+    let asm = reference.expect("at least one thread count");
+    let mass = disc.mass(&[DENSITY], false);
+    let kbar: Vec<f64> = asm
+        .tangent
+        .iter()
+        .zip(&mass)
+        .map(|(k, m)| k + m / (MATRIX_DT * MATRIX_DT))
+        .collect();
+
+    progress("METIS ordering and faer symbolic analysis");
+    let dim = pattern.dim();
+    let metis = time_reps(cfg.reps, || {
+        black_box(metis_dof_ordering(pattern).expect("METIS"));
+    });
+    let sym = SymbolicSparseColMat::new_checked(
+        dim,
+        dim,
+        pattern.col_ptr.clone(),
+        None,
+        pattern.row_idx.clone(),
+    );
+    let (fwd, inv) = metis_dof_ordering(pattern).expect("METIS");
+    let symbolic_samples = time_reps(cfg.reps, || {
+        black_box(symbolic_with(&sym, &fwd, &inv));
+    });
+    let symbolic = symbolic_with(&sym, &fwd, &inv);
+    let stats = factor_stats(&symbolic);
+    let elimination_order: Vec<usize> = match symbolic.perm() {
+        Some(p) => p.arrays().0.to_vec(),
+        None => fwd.clone(),
+    };
+    drop(symbolic);
+    let analyse = with_threads(1, || {
+        time_reps(cfg.reps, || {
+            black_box(SparseCholesky::analyse(pattern, 1).expect("analyse"));
+        })
+    });
+
+    let mut ones_image = vec![0.0; dim];
+    pattern.symmetric_matvec(&kbar, &vec![1.0; dim], &mut ones_image);
+    let mut numeric = Vec::new();
+    for &t in &cfg.threads {
+        progress(&format!("faer numeric factorisation, {t} thread(s)"));
+        let result = with_threads(t, || {
+            let mut chol = SparseCholesky::analyse(pattern, t).expect("analyse");
+            assert_eq!(chol.factor_nnz(), stats.stored, "same symbolic structure");
+            let factorise = time_reps(cfg.reps, || chol.factorise(&kbar).expect("SPD"));
+            let mut x = ones_image.clone();
+            chol.solve_in_place(&mut x);
+            let solve_error = x.iter().map(|v| (v - 1.0).abs()).fold(0.0, f64::max);
+            NumericResult {
+                threads: t,
+                factorise,
+                solve_error,
+            }
+        });
+        numeric.push(result);
+    }
+
+    let cholmod = cfg.cholmod.as_ref().map(|driver| {
+        progress("CHOLMOD");
+        let path = cfg.data_dir.join(format!("kbar_{n}.bin"));
+        export_matrix(&path, pattern, &kbar, &elimination_order)
+            .unwrap_or_else(|e| fail(&format!("cannot write {}: {e}", path.display())));
+        let run = run_cholmod(cfg, driver, &path);
+        if !cfg.keep_data {
+            let _ = std::fs::remove_file(&path);
+        }
+        run
+    });
+
+    SizeResult {
+        n,
+        elements: disc.hexes.len(),
+        dofs: dim,
+        nnz: pattern.nnz(),
+        min_j: asm.min_j,
+        assembly,
+        metis,
+        symbolic: symbolic_samples,
+        analyse,
+        stats,
+        numeric,
+        cholmod,
+    }
+}
+
+struct MicroResult {
+    with_tangent: Samples,
+    force_only: Samples,
+    iters: usize,
+}
+
+fn bench_element(cfg: &Config) -> MicroResult {
+    let h = 0.05;
+    let origin = [0.4, 0.45, 0.5];
+    let x: [[f64; 3]; 8] = std::array::from_fn(|a| {
+        let xi = adhesim::element::HEX_NODE_XI[a];
+        std::array::from_fn(|k| origin[k] + 0.5 * h * (xi[k] + 1.0))
+    });
+    let gps = hex8_geometry(&x).expect("valid element");
+    let ue: [[f64; 3]; 8] = std::array::from_fn(|a| displacement(x[a]));
+    let mat = BlatzKo::new(SHEAR_MODULUS);
+    let iters = cfg.micro_iters;
+    let run = |with_tangent: bool| {
+        with_threads(1, || {
+            time_reps(cfg.reps, || {
+                for _ in 0..iters {
+                    let r = element_response(
+                        black_box(&gps),
+                        black_box(&ue),
+                        black_box(&mat as &dyn Hyperelastic),
+                        with_tangent,
+                    );
+                    black_box(r);
+                }
+            })
+        })
+    };
+    MicroResult {
+        with_tangent: run(true),
+        force_only: run(false),
+        iters,
+    }
+}
+
+struct DynamicResult {
+    n: usize,
+    threads: usize,
+    iterations: Vec<usize>,
+    cutbacks: usize,
+    wall: f64,
+    t_end: f64,
+}
+
+/// A Blatz-Ko block, bottom face fixed, top face pushed down by 10 % of the height at
+/// constant speed over `steps` steps (θ = ξ = ½, consistent mass).
+fn bench_dynamic(n: usize, steps: usize, threads: usize) -> DynamicResult {
+    let mesh = generate::block([1.0; 3], [n; 3]);
+    let t_end = 0.2;
+    let zero = || [Table::constant(0.0), Table::constant(0.0), Table::constant(0.0)];
+    let push = Table {
+        t: vec![0.0, t_end],
+        v: vec![0.0, -0.1],
+    };
+    let problem = Problem {
+        name: "bench_dynamic".into(),
+        bodies: vec![Body {
+            name: "block".into(),
+            mesh: mesh.clone(),
+            material: material(),
+            density: DENSITY,
+            initial_velocity: [0.0; 3],
+        }],
+        dirichlet: vec![
+            Dirichlet {
+                nodes: mesh.node_sets["bottom"].clone(),
+                components: [true; 3],
+                translation: zero(),
+                rotation: None,
+            },
+            Dirichlet {
+                nodes: mesh.node_sets["top"].clone(),
+                components: [true; 3],
+                translation: [Table::constant(0.0), push, Table::constant(0.0)],
+                rotation: None,
+            },
+        ],
+        loads: vec![],
+        gravity: [0.0; 3],
+        time: TimeSettings {
+            t_end,
+            dt: t_end / steps as f64,
+            theta: 0.5,
+            xi: 0.5,
+            ..TimeSettings::default()
+        },
+        tracks: vec![],
+        output: OutputSettings {
+            frame_interval: 0.0,
+        },
+    };
+    with_threads(threads, || {
+        let t0 = Instant::now();
+        let mut stepper = Stepper::new(Arc::new(problem)).expect("set-up");
+        let mut iterations = Vec::new();
+        let mut cutbacks = 0;
+        while !stepper.finished() {
+            let r = stepper.step().expect("step");
+            iterations.push(r.newton_iterations);
+            cutbacks += r.cutbacks;
+        }
+        DynamicResult {
+            n,
+            threads,
+            iterations,
+            cutbacks,
+            wall: t0.elapsed().as_secs_f64(),
+            t_end,
+        }
+    })
+}
+
+// ---------------------------------------------------------------------------------------
+// Report
+// ---------------------------------------------------------------------------------------
+
+fn field(r: &BTreeMap<String, String>, key: &str) -> Option<f64> {
+    r.get(key).and_then(|v| v.parse().ok())
+}
+
+fn opt(v: Option<f64>, fmt: impl Fn(f64) -> String) -> String {
+    v.map(fmt).unwrap_or_else(|| "—".into())
+}
+
+fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into())
+}
+
+fn report(
+    cfg: &Config,
+    sizes: &[SizeResult],
+    micro: &MicroResult,
+    dynamic: Option<&DynamicResult>,
+) -> String {
+    let mut s = String::new();
+    let cores = std::thread::available_parallelism().map_or(0, |c| c.get());
+    let _ = writeln!(s, "# adhesim core benchmark\n");
+    let _ = writeln!(
+        s,
+        "Blatz-Ko (G = {SHEAR_MODULUS:.0e} Pa) hex8 meshes of the unit cube, displacement = 5 % \
+         stretch + shear + bubble. {cores} logical CPUs ({}). Medians of {} timed runs after one \
+         warm-up.",
+        cpu_model(),
+        cfg.reps
+    );
+    if let Some(info) = sizes.iter().find_map(|r| r.cholmod.as_ref().map(|c| &c.info)) {
+        let _ = writeln!(
+            s,
+            "CHOLMOD {} with {}.",
+            info.get("cholmod").map_or("?", String::as_str),
+            info.get("blas").map_or("?", String::as_str)
+        );
+    }
+
+    let _ = writeln!(s, "\n## 1. Assembly (element tangent + residual + scatter)\n");
+    let _ = writeln!(
+        s,
+        "| mesh | elements | dofs | nnz(K) upper | threads | assemble K+f [ms] | µs/element/core | \
+         f only [ms] | µs/element/core (f only) |"
+    );
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for r in sizes {
+        for a in &r.assembly {
+            let per = |t: f64| t * a.threads as f64 / r.elements as f64 * 1e6;
+            let _ = writeln!(
+                s,
+                "| {n}³ | {} | {} | {} | {} | {:.1} | {:.2} | {:.1} | {:.2} |",
+                r.elements,
+                r.dofs,
+                r.nnz,
+                a.threads,
+                a.with_tangent.median() * 1e3,
+                per(a.with_tangent.median()),
+                a.force_only.median() * 1e3,
+                per(a.force_only.median()),
+                n = r.n,
+            );
+        }
+    }
+    let _ = writeln!(
+        s,
+        "\nOne hex8 `element_response` (Blatz-Ko, 8 Gauss points), 1 thread, {} calls per run: \
+         **{:.2} µs** with tangent, {:.2} µs force only (target < 10 µs).",
+        micro.iters,
+        micro.with_tangent.median() / micro.iters as f64 * 1e6,
+        micro.force_only.median() / micro.iters as f64 * 1e6
+    );
+
+    let _ = writeln!(
+        s,
+        "\n## 2. Symbolic analysis of K̄ = K + M/Δt² (Δt = {MATRIX_DT:e} s, ρ = {DENSITY} kg/m³)\n"
+    );
+    let _ = writeln!(
+        s,
+        "| mesh | dofs | METIS (node graph) [ms] | faer symbolic [ms] | `analyse` total [ms] | \
+         supernodes | largest supernode | L entries (faer) | Σc² flops (faer) | CHOLMOD analyse, METIS [ms] | L entries (CHOLMOD METIS) | Σc² flops (CHOLMOD METIS) |"
+    );
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for r in sizes {
+        let cm = r.cholmod.as_ref().and_then(|c| c.any("metis", "supernodal"));
+        let _ = writeln!(
+            s,
+            "| {}³ | {} | {:.0} | {:.0} | {:.0} | {} | {} | {:.3e} | {:.3e} | {} | {} | {} |",
+            r.n,
+            r.dofs,
+            r.metis.median() * 1e3,
+            r.symbolic.median() * 1e3,
+            r.analyse.median() * 1e3,
+            if r.stats.supernodal {
+                r.stats.supernodes.to_string()
+            } else {
+                "simplicial".into()
+            },
+            r.stats.largest_supernode,
+            r.stats.stored as f64,
+            r.stats.flops,
+            opt(cm.and_then(|c| field(c, "analyse_s")), |v| format!("{:.0}", v * 1e3)),
+            opt(cm.and_then(|c| field(c, "stored")), |v| format!("{v:.3e}")),
+            opt(cm.and_then(|c| field(c, "stored_flops")), |v| format!("{v:.3e}")),
+        );
+    }
+
+    let _ = writeln!(s, "\n## 3. Numeric factorisation of K̄: faer vs CHOLMOD\n");
+    let _ = writeln!(
+        s,
+        "faer: `SparseCholesky::factorise` (adhesim's METIS node ordering). CHOLMOD (METIS): \
+         its own METIS ordering of the scalar graph. CHOLMOD (same order): the elimination \
+         order faer uses, given to CHOLMOD. Ratio = faer / CHOLMOD (target ≤ 1.3).\n"
+    );
+    let _ = writeln!(
+        s,
+        "| mesh | threads | faer [s] | faer GFlop/s | CHOLMOD METIS, supernodal [s] | faer / CHOLMOD | \
+         CHOLMOD same order, supernodal [s] | faer / CHOLMOD (same order) | CHOLMOD METIS, simplicial [s] |"
+    );
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for r in sizes {
+        for num in &r.numeric {
+            let t = num.threads;
+            let faer = num.factorise.median();
+            let c = r.cholmod.as_ref();
+            let cm = c.and_then(|c| c.find("metis", "supernodal", t)).and_then(|x| field(x, "median_s"));
+            let cg = c.and_then(|c| c.find("given", "supernodal", t)).and_then(|x| field(x, "median_s"));
+            let cs = c.and_then(|c| c.find("metis", "simplicial", t)).and_then(|x| field(x, "median_s"));
+            let _ = writeln!(
+                s,
+                "| {}³ | {} | {:.3} | {:.1} | {} | {} | {} | {} | {} |",
+                r.n,
+                t,
+                faer,
+                r.stats.flops / faer * 1e-9,
+                opt(cm, |v| format!("{v:.3}")),
+                opt(cm, |v| format!("**{:.2}**", faer / v)),
+                opt(cg, |v| format!("{v:.3}")),
+                opt(cg, |v| format!("{:.2}", faer / v)),
+                opt(cs, |v| format!("{v:.3}")),
+            );
+        }
+    }
+
+    if let Some(d) = dynamic {
+        let n_steps = d.iterations.len();
+        let total: usize = d.iterations.iter().sum();
+        let _ = writeln!(s, "\n## 4. Newton iterations on a dynamic case\n");
+        let _ = writeln!(
+            s,
+            "{n}³ Blatz-Ko block (ρ = {DENSITY} kg/m³), bottom fixed, top pushed down by 10 % over \
+             {t_end} s in {n_steps} steps, θ = ξ = ½, Newton tolerance {tol:e}, {th} thread(s).\n",
+            n = d.n,
+            t_end = d.t_end,
+            tol = TimeSettings::default().newton_tol,
+            th = d.threads
+        );
+        let _ = writeln!(s, "| steps | Newton iterations (mean) | (max) | total | cut-backs | wall time [s] | per step [s] |");
+        let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|---:|");
+        let _ = writeln!(
+            s,
+            "| {} | {:.2} | {} | {} | {} | {:.2} | {:.3} |",
+            n_steps,
+            total as f64 / n_steps.max(1) as f64,
+            d.iterations.iter().max().copied().unwrap_or(0),
+            total,
+            d.cutbacks,
+            d.wall,
+            d.wall / n_steps.max(1) as f64
+        );
+        let _ = writeln!(s, "\nIterations per step: {:?}", d.iterations);
+    }
+
+    let _ = writeln!(s, "\n## Raw samples [s]\n");
+    let fmt = |v: &Samples| {
+        format!(
+            "median {:.4}, min {:.4}, max {:.4}",
+            v.median(),
+            v.min(),
+            v.max()
+        )
+    };
+    for r in sizes {
+        let _ = writeln!(s, "- {}³: min det F = {:.4}", r.n, r.min_j);
+        for a in &r.assembly {
+            let _ = writeln!(s, "  - assemble K+f, {} thread(s): {}", a.threads, fmt(&a.with_tangent));
+            let _ = writeln!(s, "  - assemble f, {} thread(s): {}", a.threads, fmt(&a.force_only));
+        }
+        let _ = writeln!(s, "  - METIS: {}", fmt(&r.metis));
+        let _ = writeln!(s, "  - faer symbolic: {}", fmt(&r.symbolic));
+        let _ = writeln!(s, "  - analyse: {}", fmt(&r.analyse));
+        for num in &r.numeric {
+            let _ = writeln!(
+                s,
+                "  - faer factorise, {} thread(s): {}; solve max error {:.1e}",
+                num.threads,
+                fmt(&num.factorise),
+                num.solve_error
+            );
+        }
+        if let Some(c) = &r.cholmod {
+            for x in &c.results {
+                let g = |k: &str| x.get(k).map_or("?", String::as_str);
+                let _ = writeln!(
+                    s,
+                    "  - CHOLMOD {} {}, {} thread(s): median {}, min {}, max {}; analyse {} s; \
+                     lnz {}, supernodes {}, solve max error {}",
+                    g("ordering"),
+                    g("mode"),
+                    g("threads"),
+                    g("median_s"),
+                    g("min_s"),
+                    g("max_s"),
+                    g("analyse_s"),
+                    g("lnz"),
+                    g("nsuper"),
+                    g("max_err")
+                );
+            }
+            for note in &c.notes {
+                let _ = writeln!(s, "  - CHOLMOD: `{note}`");
+            }
+        }
+    }
+    let _ = writeln!(
+        s,
+        "- element_response with tangent: {} per {} calls",
+        fmt(&micro.with_tangent),
+        micro.iters
+    );
+    s
+}
+
+fn main() {
+    let cfg = parse_args();
+    let started = Instant::now();
+    eprintln!("element microbenchmark");
+    let micro = bench_element(&cfg);
+    let sizes: Vec<SizeResult> = cfg.sizes.iter().map(|&n| bench_size(&cfg, n)).collect();
+    let dynamic = (cfg.dynamic_size > 0).then(|| {
+        let threads = cfg.threads.iter().copied().max().unwrap_or(1);
+        eprintln!("dynamic case {}³, {} thread(s)", cfg.dynamic_size, threads);
+        bench_dynamic(cfg.dynamic_size, cfg.dynamic_steps, threads)
+    });
+    let text = report(&cfg, &sizes, &micro, dynamic.as_ref());
+    print!("{text}");
+    eprintln!("total benchmark time {:.0} s", started.elapsed().as_secs_f64());
+    if let Some(path) = &cfg.results {
+        std::fs::write(path, &text)
+            .unwrap_or_else(|e| fail(&format!("cannot write {}: {e}", path.display())));
+        eprintln!("report written to {}", path.display());
+    }
+}

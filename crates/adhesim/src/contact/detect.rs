@@ -1,0 +1,451 @@
+//! Contact pairs and their kinematics: detection once per step (candidates within a
+//! detection distance), closest-point projection, local frames (T₁, T₂, N), gaps and the
+//! sparse operator H (rows T₁ᵀ, T₂ᵀ, Nᵀ applied to the slave node minus the master nodes
+//! weighted by their shape functions at the projection).
+
+use crate::mesh::Face;
+use crate::problem::{rotate, Rotation, Table};
+use super::law::InterfaceLaw;
+use std::collections::HashMap;
+
+/// An analytic rigid surface, in its reference position. Slave nodes must stay on the side
+/// the normal points to.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RigidShape {
+    /// Plane through `point` with unit normal `normal` (pointing towards the slave body).
+    Plane {
+        /// A point of the plane [m].
+        point: [f64; 3],
+        /// Unit normal towards the slave side.
+        normal: [f64; 3],
+    },
+    /// Sphere; slave nodes stay outside.
+    Sphere {
+        /// Centre [m].
+        center: [f64; 3],
+        /// Radius [m].
+        radius: f64,
+    },
+    /// Infinite circular cylinder; slave nodes stay outside.
+    Cylinder {
+        /// A point of the axis [m].
+        point: [f64; 3],
+        /// Unit axis direction.
+        axis: [f64; 3],
+        /// Radius [m].
+        radius: f64,
+    },
+}
+
+/// Prescribed rigid motion of a rigid surface: x(t) = R(t)(X − c) + c + T(t).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RigidMotion {
+    /// Translation per component [m].
+    pub translation: [Table; 3],
+    /// Optional rotation about an axis through `center` (reference position).
+    pub rotation: Option<Rotation>,
+}
+
+impl RigidMotion {
+    /// Maps a reference point X to its position at time t.
+    pub fn apply(&self, x: [f64; 3], t: f64) -> [f64; 3] {
+        let mut p = x;
+        if let Some(r) = &self.rotation {
+            let d = sub(x, r.center);
+            let rd = rotate(d, r.axis, r.angle.at(t));
+            p = add(rd, r.center);
+        }
+        std::array::from_fn(|k| p[k] + self.translation[k].at(t))
+    }
+
+    /// Maps a position at time t back to the reference point.
+    pub fn inverse(&self, p: [f64; 3], t: f64) -> [f64; 3] {
+        let mut x: [f64; 3] = std::array::from_fn(|k| p[k] - self.translation[k].at(t));
+        if let Some(r) = &self.rotation {
+            let d = sub(x, r.center);
+            x = add(rotate(d, r.axis, -r.angle.at(t)), r.center);
+        }
+        x
+    }
+
+    /// Rotates a direction from the reference orientation to time t.
+    pub fn rotate_dir(&self, v: [f64; 3], t: f64) -> [f64; 3] {
+        match &self.rotation {
+            Some(r) => rotate(v, r.axis, r.angle.at(t)),
+            None => v,
+        }
+    }
+}
+
+/// The master side of a contact pair.
+#[derive(Clone, Debug)]
+pub enum Master {
+    /// A rigid analytic surface with a prescribed motion.
+    Rigid {
+        /// Shape in its reference position.
+        shape: RigidShape,
+        /// Motion.
+        motion: RigidMotion,
+    },
+    /// Boundary faces of a deformable body (global node indices, outward oriented).
+    Faces(Vec<Face>),
+}
+
+/// A contact pair: slave nodes of one body against a master surface.
+#[derive(Clone, Debug)]
+pub struct ContactPair {
+    /// Name used in outputs.
+    pub name: String,
+    /// Global indices of the slave nodes.
+    pub slave_nodes: Vec<usize>,
+    /// Tributary area of each slave node in the reference configuration [m²].
+    pub slave_area: Vec<f64>,
+    /// The master surface.
+    pub master: Master,
+    /// Friction and adhesion parameters.
+    pub law: InterfaceLaw,
+    /// Slave nodes farther than this from the master at the start of a step are not
+    /// candidates (and lose their bond) [m].
+    pub detection_distance: f64,
+}
+
+/// Tributary areas of the nodes of a face set: each face's area split equally among its
+/// nodes [m²], in the order of `nodes`.
+pub fn tributary_areas(faces: &[Face], coords: &[[f64; 3]], nodes: &[usize]) -> Vec<f64> {
+    let index: HashMap<usize, usize> = nodes.iter().enumerate().map(|(i, &n)| (n, i)).collect();
+    let mut area = vec![0.0; nodes.len()];
+    for f in faces {
+        let ns = f.nodes();
+        let a = face_area(ns, coords);
+        for n in ns {
+            if let Some(&i) = index.get(n) {
+                area[i] += a / ns.len() as f64;
+            }
+        }
+    }
+    area
+}
+
+fn face_area(ns: &[usize], x: &[[f64; 3]]) -> f64 {
+    let c = |i: usize| x[ns[i]];
+    match ns.len() {
+        3 => 0.5 * norm(cross(sub(c(1), c(0)), sub(c(2), c(0)))),
+        _ => 0.5 * norm(cross(sub(c(2), c(0)), sub(c(3), c(1)))),
+    }
+}
+
+/// One candidate contact point of a step: frame, gap and the rows of H.
+#[derive(Clone, Debug)]
+pub struct ContactPoint {
+    /// Pair index.
+    pub pair: usize,
+    /// Index of the slave node within the pair.
+    pub local: usize,
+    /// Global slave node.
+    pub slave: usize,
+    /// Tributary area [m²].
+    pub area: f64,
+    /// Local frame: rows T₁, T₂, N (unit, right-handed; N points from master to slave).
+    pub frame: [[f64; 3]; 3],
+    /// Master nodes and their weights (shape functions at the projection); empty for a
+    /// rigid master.
+    pub master: Vec<(usize, f64)>,
+    /// Position of the master material point at the end of the step for a rigid master, at
+    /// the start of the step for a deformable one (its motion then comes from u) [m].
+    pub master_point_end: [f64; 3],
+    /// Relative position slave − master at the start of the step, in global axes [m].
+    pub d0: [f64; 3],
+}
+
+impl ContactPoint {
+    /// Local relative displacement x = (slip increment t₁, t₂, end gap n) for the end-of-step
+    /// displacement `u` [m] (H applied to u plus the constant part).
+    pub fn local_x(&self, reference: &[[f64; 3]], u: &[f64]) -> [f64; 3] {
+        let d1 = self.relative_position(reference, u);
+        let f = &self.frame;
+        let ds = sub(d1, self.d0);
+        [dot(f[0], ds), dot(f[1], ds), dot(f[2], d1)]
+    }
+
+    fn relative_position(&self, reference: &[[f64; 3]], u: &[f64]) -> [f64; 3] {
+        let s = self.slave;
+        let xs: [f64; 3] = std::array::from_fn(|k| reference[s][k] + u[3 * s + k]);
+        if self.master.is_empty() {
+            return sub(xs, self.master_point_end);
+        }
+        let mut xm = [0.0; 3];
+        for &(m, w) in &self.master {
+            for k in 0..3 {
+                xm[k] += w * (reference[m][k] + u[3 * m + k]);
+            }
+        }
+        sub(xs, xm)
+    }
+
+    /// Adds Hᵀ r (r in local axes) to a global vector.
+    pub fn add_ht(&self, r: [f64; 3], out: &mut [f64]) {
+        let f = &self.frame;
+        let g: [f64; 3] = std::array::from_fn(|k| r[0] * f[0][k] + r[1] * f[1][k] + r[2] * f[2][k]);
+        for k in 0..3 {
+            out[3 * self.slave + k] += g[k];
+        }
+        for &(m, w) in &self.master {
+            for k in 0..3 {
+                out[3 * m + k] -= w * g[k];
+            }
+        }
+    }
+
+    /// H v: the local components of a global displacement field v.
+    pub fn apply_h(&self, v: &[f64]) -> [f64; 3] {
+        let s = self.slave;
+        let mut d: [f64; 3] = std::array::from_fn(|k| v[3 * s + k]);
+        for &(m, w) in &self.master {
+            for k in 0..3 {
+                d[k] -= w * v[3 * m + k];
+            }
+        }
+        let f = &self.frame;
+        [dot(f[0], d), dot(f[1], d), dot(f[2], d)]
+    }
+}
+
+/// Detects the contact points of all pairs at the start of a step [t0, t1] from the
+/// displacement `u0`.
+pub fn detect(pairs: &[ContactPair], reference: &[[f64; 3]], u0: &[f64], t0: f64, t1: f64) -> Vec<ContactPoint> {
+    let pos = |n: usize| -> [f64; 3] { std::array::from_fn(|k| reference[n][k] + u0[3 * n + k]) };
+    let mut out = Vec::new();
+    for (pi, pair) in pairs.iter().enumerate() {
+        match &pair.master {
+            Master::Rigid { shape, motion } => {
+                for (li, &s) in pair.slave_nodes.iter().enumerate() {
+                    let xs = pos(s);
+                    // Work in the surface's reference frame.
+                    let xr = motion.inverse(xs, t0);
+                    let (proj, normal, gap) = rigid_projection(shape, xr);
+                    if gap > pair.detection_distance {
+                        continue;
+                    }
+                    let p0 = motion.apply(proj, t0);
+                    let n0 = motion.rotate_dir(normal, t0);
+                    out.push(ContactPoint {
+                        pair: pi,
+                        local: li,
+                        slave: s,
+                        area: pair.slave_area[li],
+                        frame: frame_from_normal(n0),
+                        master: Vec::new(),
+                        master_point_end: motion.apply(proj, t1),
+                        d0: sub(xs, p0),
+                    });
+                }
+            }
+            Master::Faces(faces) => {
+                let grid = FaceGrid::new(faces, &pos, pair.detection_distance);
+                for (li, &s) in pair.slave_nodes.iter().enumerate() {
+                    let xs = pos(s);
+                    let mut best: Option<(f64, [f64; 3], Vec<(usize, f64)>, [f64; 3])> = None;
+                    for &fi in grid.candidates(xs) {
+                        let face = &faces[fi];
+                        if face.nodes().contains(&s) {
+                            continue;
+                        }
+                        let (xm, normal, weights) = project_on_face(face, &pos, xs);
+                        let d = sub(xs, xm);
+                        let dist = norm(d);
+                        let gap = dot(d, normal);
+                        // Accept points on the outer side (or slightly penetrated) whose
+                        // projection is close to the face.
+                        if dist > pair.detection_distance || gap < -pair.detection_distance {
+                            continue;
+                        }
+                        if best.as_ref().map_or(true, |b| dist < b.0) {
+                            let nodes: Vec<(usize, f64)> = face.nodes().iter().copied().zip(weights).collect();
+                            best = Some((dist, normal, nodes, xm));
+                        }
+                    }
+                    if let Some((_, normal, master, xm)) = best {
+                        out.push(ContactPoint {
+                            pair: pi,
+                            local: li,
+                            slave: s,
+                            area: pair.slave_area[li],
+                            frame: frame_from_normal(normal),
+                            master,
+                            master_point_end: xm,
+                            d0: sub(xs, xm),
+                        });
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Closest point, outward unit normal and signed gap of a point (in the surface's
+/// reference frame).
+pub fn rigid_projection(shape: &RigidShape, x: [f64; 3]) -> ([f64; 3], [f64; 3], f64) {
+    match shape {
+        RigidShape::Plane { point, normal } => {
+            let g = dot(sub(x, *point), *normal);
+            (std::array::from_fn(|k| x[k] - g * normal[k]), *normal, g)
+        }
+        RigidShape::Sphere { center, radius } => {
+            let d = sub(x, *center);
+            let r = norm(d);
+            let n = if r > 0.0 { d.map(|v| v / r) } else { [0.0, 1.0, 0.0] };
+            (std::array::from_fn(|k| center[k] + radius * n[k]), n, r - radius)
+        }
+        RigidShape::Cylinder { point, axis, radius } => {
+            let d = sub(x, *point);
+            let along = dot(d, *axis);
+            let radial: [f64; 3] = std::array::from_fn(|k| d[k] - along * axis[k]);
+            let r = norm(radial);
+            let n = if r > 0.0 { radial.map(|v| v / r) } else { [0.0, 1.0, 0.0] };
+            (std::array::from_fn(|k| point[k] + along * axis[k] + radius * n[k]), n, r - radius)
+        }
+    }
+}
+
+/// Closest-point projection of `x` on a face (bilinear quad by Newton in (ξ, η), clamped to
+/// the face; linear triangle in closed form); returns the point, the face's unit normal
+/// there and the nodal weights.
+pub fn project_on_face(face: &Face, pos: &dyn Fn(usize) -> [f64; 3], x: [f64; 3]) -> ([f64; 3], [f64; 3], Vec<f64>) {
+    match face {
+        Face::Quad(ns) => {
+            let p: [[f64; 3]; 4] = ns.map(pos);
+            let (mut a, mut b) = (0.0f64, 0.0f64);
+            let eval = |a: f64, b: f64| {
+                let w = [0.25 * (1.0 - a) * (1.0 - b), 0.25 * (1.0 + a) * (1.0 - b), 0.25 * (1.0 + a) * (1.0 + b), 0.25 * (1.0 - a) * (1.0 + b)];
+                let da = [-0.25 * (1.0 - b), 0.25 * (1.0 - b), 0.25 * (1.0 + b), -0.25 * (1.0 + b)];
+                let db = [-0.25 * (1.0 - a), -0.25 * (1.0 + a), 0.25 * (1.0 + a), 0.25 * (1.0 - a)];
+                let comb = |c: [f64; 4]| -> [f64; 3] { std::array::from_fn(|k| (0..4).map(|i| c[i] * p[i][k]).sum()) };
+                (w, comb(w), comb(da), comb(db))
+            };
+            for _ in 0..20 {
+                let (_, xm, ta, tb) = eval(a, b);
+                let r = sub(x, xm);
+                // Gauss-Newton on ‖x − x(ξ,η)‖².
+                let (g1, g2) = (dot(r, ta), dot(r, tb));
+                let (m11, m12, m22) = (dot(ta, ta), dot(ta, tb), dot(tb, tb));
+                let det = m11 * m22 - m12 * m12;
+                if !(det > 0.0) {
+                    break;
+                }
+                let da = (m22 * g1 - m12 * g2) / det;
+                let db = (m11 * g2 - m12 * g1) / det;
+                a = (a + da).clamp(-1.0, 1.0);
+                b = (b + db).clamp(-1.0, 1.0);
+                if da.abs() + db.abs() < 1e-12 {
+                    break;
+                }
+            }
+            let (w, xm, ta, tb) = eval(a, b);
+            let n = normalize(cross(ta, tb));
+            (xm, n, w.to_vec())
+        }
+        Face::Tri(ns) => {
+            let p: [[f64; 3]; 3] = ns.map(pos);
+            let (e1, e2) = (sub(p[1], p[0]), sub(p[2], p[0]));
+            let n = normalize(cross(e1, e2));
+            let r = sub(x, p[0]);
+            let (m11, m12, m22) = (dot(e1, e1), dot(e1, e2), dot(e2, e2));
+            let (g1, g2) = (dot(r, e1), dot(r, e2));
+            let det = m11 * m22 - m12 * m12;
+            let mut a = (m22 * g1 - m12 * g2) / det;
+            let mut b = (m11 * g2 - m12 * g1) / det;
+            a = a.max(0.0);
+            b = b.max(0.0);
+            let s = a + b;
+            if s > 1.0 {
+                a /= s;
+                b /= s;
+            }
+            let w = vec![1.0 - a - b, a, b];
+            let xm = std::array::from_fn(|k| w[0] * p[0][k] + w[1] * p[1][k] + w[2] * p[2][k]);
+            (xm, n, w)
+        }
+    }
+}
+
+/// A uniform grid over the master faces' bounding boxes (inflated by the detection
+/// distance), so each slave node looks only at nearby faces.
+struct FaceGrid {
+    cell: f64,
+    map: HashMap<[i64; 3], Vec<usize>>,
+}
+
+impl FaceGrid {
+    fn new(faces: &[Face], pos: &dyn Fn(usize) -> [f64; 3], pad: f64) -> Self {
+        let boxes: Vec<([f64; 3], [f64; 3])> = faces
+            .iter()
+            .map(|f| {
+                let mut lo = [f64::INFINITY; 3];
+                let mut hi = [f64::NEG_INFINITY; 3];
+                for &n in f.nodes() {
+                    let p = pos(n);
+                    for k in 0..3 {
+                        lo[k] = lo[k].min(p[k] - pad);
+                        hi[k] = hi[k].max(p[k] + pad);
+                    }
+                }
+                (lo, hi)
+            })
+            .collect();
+        let mean = boxes.iter().map(|(l, h)| (0..3).map(|k| h[k] - l[k]).fold(0.0, f64::max)).sum::<f64>()
+            / boxes.len().max(1) as f64;
+        let cell = mean.max(1e-12);
+        let mut map: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
+        for (i, (lo, hi)) in boxes.iter().enumerate() {
+            let a = lo.map(|v| (v / cell).floor() as i64);
+            let b = hi.map(|v| (v / cell).floor() as i64);
+            for x in a[0]..=b[0] {
+                for y in a[1]..=b[1] {
+                    for z in a[2]..=b[2] {
+                        map.entry([x, y, z]).or_default().push(i);
+                    }
+                }
+            }
+        }
+        FaceGrid { cell, map }
+    }
+
+    fn candidates(&self, x: [f64; 3]) -> &[usize] {
+        let key = x.map(|v| (v / self.cell).floor() as i64);
+        self.map.get(&key).map_or(&[], |v| v.as_slice())
+    }
+}
+
+/// Right-handed local frame (rows T₁, T₂, N) from a unit normal N. T₁ = N × e_z normalised
+/// (so that for normals in the x-y plane of a plane-strain slab T₁ lies in that plane), or
+/// N × e_x when N is close to e_z.
+pub fn frame_from_normal(n: [f64; 3]) -> [[f64; 3]; 3] {
+    let t1 = if n[2].abs() < 0.9 { normalize(cross(n, [0.0, 0.0, 1.0])) } else { normalize(cross(n, [1.0, 0.0, 0.0])) };
+    let t2 = cross(n, t1);
+    [t1, t2, n]
+}
+
+pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+pub(crate) fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+pub(crate) fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+pub(crate) fn normalize(a: [f64; 3]) -> [f64; 3] {
+    let n = norm(a);
+    if n > 0.0 {
+        a.map(|v| v / n)
+    } else {
+        [0.0, 1.0, 0.0]
+    }
+}

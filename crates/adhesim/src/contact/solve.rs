@@ -1,0 +1,141 @@
+//! The reduced contact system inside a Newton iteration (model.md §6): the Delassus operator
+//! W = H K̄⁻¹ Hᵀ from one multi-right-hand-side solve with the iteration's factorisation, and
+//! a nonlinear Gauss-Seidel sweep over contact points with the local bi-potential/RCC solve.
+
+use super::detect::ContactPoint;
+use super::law::{default_rho, solve_point, BondState, InterfaceLaw, PointProblem, PointSolution};
+use crate::linalg::SparseCholesky;
+
+/// The columns K̄⁻¹Hᵀ (column-major, 3 per contact point) and the dense Delassus operator.
+pub struct Delassus {
+    /// K̄⁻¹Hᵀ, n_dofs × 3N_c, column-major [m/N].
+    pub z: Vec<f64>,
+    /// W = H K̄⁻¹ Hᵀ, 3N_c × 3N_c, row-major [m/N].
+    pub w: Vec<f64>,
+    /// 3N_c.
+    pub m: usize,
+}
+
+/// Builds K̄⁻¹Hᵀ and W with the current factorisation; constrained unknowns get no contact
+/// force.
+pub fn delassus(points: &[ContactPoint], chol: &mut SparseCholesky, constrained: &[bool]) -> Delassus {
+    let n = constrained.len();
+    let m = 3 * points.len();
+    let mut z = vec![0.0; n * m];
+    for (p, pt) in points.iter().enumerate() {
+        for c in 0..3 {
+            let col = &mut z[(3 * p + c) * n..(3 * p + c + 1) * n];
+            let mut r = [0.0; 3];
+            r[c] = 1.0;
+            pt.add_ht(r, col);
+            for (v, &fixed) in col.iter_mut().zip(constrained) {
+                if fixed {
+                    *v = 0.0;
+                }
+            }
+        }
+    }
+    chol.solve_in_place(&mut z);
+    let mut w = vec![0.0; m * m];
+    for col in 0..m {
+        let zc = &z[col * n..(col + 1) * n];
+        for (p, pt) in points.iter().enumerate() {
+            let h = pt.apply_h(zc);
+            for a in 0..3 {
+                w[(3 * p + a) * m + col] = h[a];
+            }
+        }
+    }
+    // Symmetrise (W is symmetric in exact arithmetic).
+    for i in 0..m {
+        for j in 0..i {
+            let s = 0.5 * (w[i * m + j] + w[j * m + i]);
+            w[i * m + j] = s;
+            w[j * m + i] = s;
+        }
+    }
+    Delassus { z, w, m }
+}
+
+/// Result of the Gauss-Seidel solve.
+pub struct ContactSolution {
+    /// Per point: the local solution (dry and adhesive forces, x, β, u_t, state).
+    pub points: Vec<PointSolution>,
+    /// Sweeps done.
+    pub sweeps: usize,
+    /// Whether the sweeps settled within the tolerance.
+    pub converged: bool,
+}
+
+/// Nonlinear Gauss-Seidel over contact points: x = x_free + W r, with each point's law.
+/// `r_start` warm-starts the total force per point, `dry_start` the dry part.
+#[allow(clippy::too_many_arguments)]
+pub fn gauss_seidel(
+    points: &[ContactPoint],
+    laws: &[InterfaceLaw],
+    bond0: &[BondState],
+    dt: f64,
+    del: &Delassus,
+    x_free: &[[f64; 3]],
+    r_start: &[[f64; 3]],
+    dry_start: &[[f64; 3]],
+    tol: f64,
+    max_sweeps: usize,
+) -> ContactSolution {
+    let np = points.len();
+    let m = del.m;
+    let mut r: Vec<[f64; 3]> = r_start.to_vec();
+    let mut sols: Vec<Option<PointSolution>> = vec![None; np];
+    let mut dry: Vec<[f64; 3]> = dry_start.to_vec();
+    let blocks: Vec<[[f64; 3]; 3]> = (0..np)
+        .map(|p| std::array::from_fn(|a| std::array::from_fn(|c| del.w[(3 * p + a) * m + 3 * p + c])))
+        .collect();
+    let rhos: Vec<f64> = blocks.iter().map(|b| default_rho(*b)).collect();
+    let mut converged = false;
+    let mut sweeps = 0;
+    while sweeps < max_sweeps {
+        sweeps += 1;
+        let mut change: f64 = 0.0;
+        let mut scale: f64 = 0.0;
+        for p in 0..np {
+            // x_free of this point with every other point's current force.
+            let mut xf = x_free[p];
+            for q in 0..np {
+                if q == p {
+                    continue;
+                }
+                let rq = r[q];
+                if rq == [0.0; 3] {
+                    continue;
+                }
+                for a in 0..3 {
+                    let row = &del.w[(3 * p + a) * m + 3 * q..(3 * p + a) * m + 3 * q + 3];
+                    xf[a] += row[0] * rq[0] + row[1] * rq[1] + row[2] * rq[2];
+                }
+            }
+            let pp = PointProblem {
+                w_aa: blocks[p],
+                x_free: xf,
+                law: &laws[points[p].pair],
+                bond0: bond0[p],
+                dt,
+                area: points[p].area,
+                rho: rhos[p],
+            };
+            let sol = solve_point(&pp, dry[p], 1e-12, 200);
+            let rn = sol.r();
+            for a in 0..3 {
+                change = change.max((rn[a] - r[p][a]).abs());
+                scale = scale.max(rn[a].abs());
+            }
+            r[p] = rn;
+            dry[p] = sol.r_dry;
+            sols[p] = Some(sol);
+        }
+        if change <= tol * scale || scale == 0.0 {
+            converged = true;
+            break;
+        }
+    }
+    ContactSolution { points: sols.into_iter().map(|s| s.expect("every point solved")).collect(), sweeps, converged }
+}
