@@ -28,6 +28,7 @@ use faer::sparse::linalg::cholesky::{
 };
 use faer::sparse::SymbolicSparseColMat;
 use faer::Side;
+use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
 use std::fmt::Write as _;
@@ -234,6 +235,7 @@ struct AssemblyResult {
     threads: usize,
     with_tangent: Samples,
     force_only: Samples,
+    kernels_only: Samples,
 }
 
 struct FactorStats {
@@ -258,7 +260,12 @@ struct CholmodRun {
 }
 
 impl CholmodRun {
-    fn find(&self, ordering: &str, mode: &str, threads: usize) -> Option<&BTreeMap<String, String>> {
+    fn find(
+        &self,
+        ordering: &str,
+        mode: &str,
+        threads: usize,
+    ) -> Option<&BTreeMap<String, String>> {
         self.results.iter().find(|r| {
             r.get("ordering").map(String::as_str) == Some(ordering)
                 && r.get("mode").map(String::as_str) == Some(mode)
@@ -345,7 +352,12 @@ fn symbolic_with(
 
 /// Writes the upper-triangle CSC matrix and an elimination order in the ADHKBAR1 format
 /// read by bench/cholmod/cholmod_bench.
-fn export_matrix(path: &Path, p: &BlockPattern, values: &[f64], perm: &[usize]) -> std::io::Result<()> {
+fn export_matrix(
+    path: &Path,
+    p: &BlockPattern,
+    values: &[f64],
+    perm: &[usize],
+) -> std::io::Result<()> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir)?;
     }
@@ -401,7 +413,10 @@ fn run_cholmod(cfg: &Config, driver: &Path, matrix: &Path) -> CholmodRun {
         .args(["--threads", &threads.join(",")])
         .args(["--orderings", &cfg.cholmod_orderings])
         .args(["--modes", &cfg.cholmod_modes])
-        .args(["--simplicial-max-gflop", &cfg.simplicial_max_gflop.to_string()])
+        .args([
+            "--simplicial-max-gflop",
+            &cfg.simplicial_max_gflop.to_string(),
+        ])
         .output()
         .unwrap_or_else(|e| fail(&format!("cannot run {}: {e}", driver.display())));
     if !output.status.success() {
@@ -422,30 +437,57 @@ fn run_cholmod(cfg: &Config, driver: &Path, matrix: &Path) -> CholmodRun {
     run
 }
 
+/// The element kernels of a full assembly (gather + element response with tangent) without
+/// the scatter into the global arrays; returns the summed energy.
+fn kernels_only(disc: &Discretisation, u: &[f64]) -> f64 {
+    let hexes = &disc.hexes;
+    (0..hexes.len())
+        .into_par_iter()
+        .with_min_len(64)
+        .map(|e| {
+            let en = &hexes.nodes[e];
+            let ue: [[f64; 3]; 8] =
+                std::array::from_fn(|a| std::array::from_fn(|k| u[3 * en[a] + k]));
+            let mat = &*disc.materials[hexes.body[e]];
+            let r = element_response(&hexes.gauss[e], &ue, mat, true);
+            black_box(&r.tangent);
+            r.energy
+        })
+        .sum()
+}
+
 fn bench_size(cfg: &Config, n: usize) -> SizeResult {
     let progress = |what: &str| eprintln!("[{n}³] {what}");
     let mesh = generate::block([1.0; 3], [n; 3]);
     let disc = Discretisation::new(&[(&mesh, material())]).expect("valid mesh");
-    let u: Vec<f64> = disc.reference.iter().flat_map(|&x| displacement(x)).collect();
+    let u: Vec<f64> = disc
+        .reference
+        .iter()
+        .flat_map(|&x| displacement(x))
+        .collect();
     let pattern = &disc.pattern;
 
     progress("assembly");
     let mut assembly = Vec::new();
     let mut reference = None;
     for &t in &cfg.threads {
-        let (with_tangent, force_only, asm) = with_threads(t, || {
+        let (with_tangent, force_only, kernels, asm) = with_threads(t, || {
             let with_tangent = time_reps(cfg.reps, || {
                 black_box(disc.assemble(black_box(&u), true));
             });
             let force_only = time_reps(cfg.reps, || {
                 black_box(disc.assemble(black_box(&u), false));
             });
-            (with_tangent, force_only, disc.assemble(&u, true))
+            let kernels = time_reps(cfg.reps, || {
+                black_box(kernels_only(&disc, black_box(&u)));
+            });
+            (with_tangent, force_only, kernels, disc.assemble(&u, true))
         });
         assembly.push(AssemblyResult {
             threads: t,
             with_tangent,
             force_only,
+            kernels_only: kernels,
         });
         reference.get_or_insert(asm);
     }
@@ -589,7 +631,13 @@ struct DynamicResult {
 fn bench_dynamic(n: usize, steps: usize, threads: usize) -> DynamicResult {
     let mesh = generate::block([1.0; 3], [n; 3]);
     let t_end = 0.2;
-    let zero = || [Table::constant(0.0), Table::constant(0.0), Table::constant(0.0)];
+    let zero = || {
+        [
+            Table::constant(0.0),
+            Table::constant(0.0),
+            Table::constant(0.0),
+        ]
+    };
     let push = Table {
         t: vec![0.0, t_end],
         v: vec![0.0, -0.1],
@@ -626,6 +674,7 @@ fn bench_dynamic(n: usize, steps: usize, threads: usize) -> DynamicResult {
             xi: 0.5,
             ..TimeSettings::default()
         },
+        contacts: vec![],
         tracks: vec![],
         output: OutputSettings {
             frame_interval: 0.0,
@@ -693,7 +742,10 @@ fn report(
         cpu_model(),
         cfg.reps
     );
-    if let Some(info) = sizes.iter().find_map(|r| r.cholmod.as_ref().map(|c| &c.info)) {
+    if let Some(info) = sizes
+        .iter()
+        .find_map(|r| r.cholmod.as_ref().map(|c| &c.info))
+    {
         let _ = writeln!(
             s,
             "CHOLMOD {} with {}.",
@@ -702,25 +754,29 @@ fn report(
         );
     }
 
-    let _ = writeln!(s, "\n## 1. Assembly (element tangent + residual + scatter)\n");
+    let _ = writeln!(
+        s,
+        "\n## 1. Assembly (element tangent + residual + scatter)\n"
+    );
     let _ = writeln!(
         s,
         "| mesh | elements | dofs | nnz(K) upper | threads | assemble K+f [ms] | µs/element/core | \
-         f only [ms] | µs/element/core (f only) |"
+         element kernels only, µs/element/core | f only [ms] | µs/element/core (f only) |"
     );
-    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for r in sizes {
         for a in &r.assembly {
             let per = |t: f64| t * a.threads as f64 / r.elements as f64 * 1e6;
             let _ = writeln!(
                 s,
-                "| {n}³ | {} | {} | {} | {} | {:.1} | {:.2} | {:.1} | {:.2} |",
+                "| {n}³ | {} | {} | {} | {} | {:.1} | {:.2} | {:.2} | {:.1} | {:.2} |",
                 r.elements,
                 r.dofs,
                 r.nnz,
                 a.threads,
                 a.with_tangent.median() * 1e3,
                 per(a.with_tangent.median()),
+                per(a.kernels_only.median()),
                 a.force_only.median() * 1e3,
                 per(a.force_only.median()),
                 n = r.n,
@@ -745,9 +801,15 @@ fn report(
         "| mesh | dofs | METIS (node graph) [ms] | faer symbolic [ms] | `analyse` total [ms] | \
          supernodes | largest supernode | L entries (faer) | Σc² flops (faer) | CHOLMOD analyse, METIS [ms] | L entries (CHOLMOD METIS) | Σc² flops (CHOLMOD METIS) |"
     );
-    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(
+        s,
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
     for r in sizes {
-        let cm = r.cholmod.as_ref().and_then(|c| c.any("metis", "supernodal"));
+        let cm = r
+            .cholmod
+            .as_ref()
+            .and_then(|c| c.any("metis", "supernodal"));
         let _ = writeln!(
             s,
             "| {}³ | {} | {:.0} | {:.0} | {:.0} | {} | {} | {:.3e} | {:.3e} | {} | {} | {} |",
@@ -764,9 +826,14 @@ fn report(
             r.stats.largest_supernode,
             r.stats.stored as f64,
             r.stats.flops,
-            opt(cm.and_then(|c| field(c, "analyse_s")), |v| format!("{:.0}", v * 1e3)),
+            opt(cm.and_then(|c| field(c, "analyse_s")), |v| format!(
+                "{:.0}",
+                v * 1e3
+            )),
             opt(cm.and_then(|c| field(c, "stored")), |v| format!("{v:.3e}")),
-            opt(cm.and_then(|c| field(c, "stored_flops")), |v| format!("{v:.3e}")),
+            opt(cm.and_then(|c| field(c, "stored_flops")), |v| format!(
+                "{v:.3e}"
+            )),
         );
     }
 
@@ -788,9 +855,15 @@ fn report(
             let t = num.threads;
             let faer = num.factorise.median();
             let c = r.cholmod.as_ref();
-            let cm = c.and_then(|c| c.find("metis", "supernodal", t)).and_then(|x| field(x, "median_s"));
-            let cg = c.and_then(|c| c.find("given", "supernodal", t)).and_then(|x| field(x, "median_s"));
-            let cs = c.and_then(|c| c.find("metis", "simplicial", t)).and_then(|x| field(x, "median_s"));
+            let cm = c
+                .and_then(|c| c.find("metis", "supernodal", t))
+                .and_then(|x| field(x, "median_s"));
+            let cg = c
+                .and_then(|c| c.find("given", "supernodal", t))
+                .and_then(|x| field(x, "median_s"));
+            let cs = c
+                .and_then(|c| c.find("metis", "simplicial", t))
+                .and_then(|x| field(x, "median_s"));
             let _ = writeln!(
                 s,
                 "| {}³ | {} | {:.3} | {:.1} | {} | {} | {} | {} | {} |",
@@ -848,8 +921,24 @@ fn report(
     for r in sizes {
         let _ = writeln!(s, "- {}³: min det F = {:.4}", r.n, r.min_j);
         for a in &r.assembly {
-            let _ = writeln!(s, "  - assemble K+f, {} thread(s): {}", a.threads, fmt(&a.with_tangent));
-            let _ = writeln!(s, "  - assemble f, {} thread(s): {}", a.threads, fmt(&a.force_only));
+            let _ = writeln!(
+                s,
+                "  - assemble K+f, {} thread(s): {}",
+                a.threads,
+                fmt(&a.with_tangent)
+            );
+            let _ = writeln!(
+                s,
+                "  - assemble f, {} thread(s): {}",
+                a.threads,
+                fmt(&a.force_only)
+            );
+            let _ = writeln!(
+                s,
+                "  - element kernels only, {} thread(s): {}",
+                a.threads,
+                fmt(&a.kernels_only)
+            );
         }
         let _ = writeln!(s, "  - METIS: {}", fmt(&r.metis));
         let _ = writeln!(s, "  - faer symbolic: {}", fmt(&r.symbolic));
@@ -909,7 +998,10 @@ fn main() {
     });
     let text = report(&cfg, &sizes, &micro, dynamic.as_ref());
     print!("{text}");
-    eprintln!("total benchmark time {:.0} s", started.elapsed().as_secs_f64());
+    eprintln!(
+        "total benchmark time {:.0} s",
+        started.elapsed().as_secs_f64()
+    );
     if let Some(path) = &cfg.results {
         std::fs::write(path, &text)
             .unwrap_or_else(|e| fail(&format!("cannot write {}: {e}", path.display())));

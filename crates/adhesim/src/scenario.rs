@@ -4,11 +4,11 @@
 //! then checks values (positive moduli, time step, existing node sets, ...) and names the key
 //! that is wrong and what would be valid. The format is documented in `docs/scenario.md`.
 
-use crate::material::{self, Hyperelastic};
-use crate::mesh::generate::{self, FlatSide};
 use crate::contact::detect::tributary_areas;
 use crate::contact::law::DEFAULT_BETA_EPS;
 use crate::contact::{ContactPair, InterfaceLaw, Master, RccParams, RigidMotion, RigidShape};
+use crate::material::{self, Hyperelastic};
+use crate::mesh::generate::{self, FlatSide};
 use crate::mesh::{Face, Mesh};
 use crate::problem::{
     Body, Dirichlet, NodalLoad, OutputSettings, Problem, Rotation, Table, TimeSettings, Track,
@@ -468,13 +468,23 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
     }
     let mut contacts = Vec::new();
     for (i, c) in raw.contacts.iter().enumerate() {
-        contacts.push(build_contact(c, &format!("contact[{i}]"), &bodies, &body_index, &offsets, ctx)?);
+        contacts.push(build_contact(
+            c,
+            &format!("contact[{i}]"),
+            &bodies,
+            &body_index,
+            &offsets,
+            ctx,
+        )?);
     }
     {
         let mut names = std::collections::BTreeSet::new();
         for (i, c) in contacts.iter().enumerate() {
             if !names.insert(c.name.clone()) {
-                return Err(ctx.err(format!("`contact[{i}].name`: the name {:?} is used twice; names must be unique", c.name)));
+                return Err(ctx.err(format!(
+                    "`contact[{i}].name`: the name {:?} is used twice; names must be unique",
+                    c.name
+                )));
             }
         }
     }
@@ -805,7 +815,10 @@ fn build_contact(
     ctx: &Ctx,
 ) -> Result<ContactPair, ScenarioError> {
     if c.name.is_empty() || c.name.contains([',', '"', '\n', '.']) {
-        return Err(ctx.err(format!("`{key}.name` must be non-empty and hold no comma, dot or quote, got {:?}", c.name)));
+        return Err(ctx.err(format!(
+            "`{key}.name` must be non-empty and hold no comma, dot or quote, got {:?}",
+            c.name
+        )));
     }
     let lookup = |k: &str, body: &str| -> Result<usize, ScenarioError> {
         body_index.get(body).copied().ok_or_else(|| {
@@ -823,7 +836,11 @@ fn build_contact(
             None => Err(ctx.err(format!(
                 "`{k}` = {set:?} is not a face set of body {:?}; its face sets are: {}",
                 bodies[bi].name,
-                mesh.face_sets.keys().cloned().collect::<Vec<_>>().join(", ")
+                mesh.face_sets
+                    .keys()
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join(", ")
             ))),
         }
     };
@@ -840,7 +857,8 @@ fn build_contact(
             let ns = f.nodes();
             for i in 0..ns.len() {
                 let (a, b) = (mesh.nodes[ns[i]], mesh.nodes[ns[(i + 1) % ns.len()]]);
-                sum += ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+                sum +=
+                    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
                 count += 1;
             }
         }
@@ -914,7 +932,9 @@ fn build_contact(
     };
     let mu = c.friction;
     if !(mu.is_finite() && mu >= 0.0) {
-        return Err(ctx.err(format!("`{key}.friction` must be a finite number ≥ 0 (0 = frictionless), got {mu}")));
+        return Err(ctx.err(format!(
+            "`{key}.friction` must be a finite number ≥ 0 (0 = frictionless), got {mu}"
+        )));
     }
     let adhesion = match &c.adhesion {
         None => None,
@@ -922,7 +942,10 @@ fn build_contact(
             let w = ctx.positive(&format!("{key}.adhesion.w"), a.w)?;
             let cn = ctx.positive(&format!("{key}.adhesion.cn"), a.cn)?;
             if !(a.ct.is_finite() && a.ct >= 0.0) {
-                return Err(ctx.err(format!("`{key}.adhesion.ct` must be a finite number ≥ 0 [N/m³], got {}", a.ct)));
+                return Err(ctx.err(format!(
+                    "`{key}.adhesion.ct` must be a finite number ≥ 0 [N/m³], got {}",
+                    a.ct
+                )));
             }
             if !(a.b.is_finite() && a.b >= 0.0) {
                 return Err(ctx.err(format!("`{key}.adhesion.b` must be a finite number ≥ 0 [N·s/m] (0 = rate-independent), got {}", a.b)));
@@ -931,7 +954,13 @@ fn build_contact(
             if !(eps > 0.0 && eps < 1.0) {
                 return Err(ctx.err(format!("`{key}.adhesion.eps` must be in (0, 1), got {eps}")));
             }
-            Some(RccParams { w, cn, ct: a.ct, b: a.b, eps })
+            Some(RccParams {
+                w,
+                cn,
+                ct: a.ct,
+                b: a.b,
+                eps,
+            })
         }
     };
     let detection_distance = match c.detection_distance {

@@ -135,6 +135,8 @@ pub struct Stepper {
     last_internal: f64,
     /// Committed contact state per pair and slave node.
     pub contact: Vec<Vec<NodeContact>>,
+    /// Diagonal of the bounding box of the reference nodes [m].
+    model_size: f64,
 }
 
 struct Attempt {
@@ -227,12 +229,29 @@ impl Stepper {
             external_work: 0.0,
             last_internal: 0.0,
             contact: Vec::new(),
+            model_size: 0.0,
         };
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for p in &s.disc.reference {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        s.model_size = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
         s.contact = s
             .problem
             .contacts
             .iter()
-            .map(|c| vec![NodeContact { gap: f64::NAN, ..Default::default() }; c.slave_nodes.len()])
+            .map(|c| {
+                vec![
+                    NodeContact {
+                        gap: f64::NAN,
+                        ..Default::default()
+                    };
+                    c.slave_nodes.len()
+                ]
+            })
             .collect();
         s.apply_dirichlet_to_state();
         s.f_ext0 = s.external_force(0.0);
@@ -355,13 +374,18 @@ impl Stepper {
     fn commit_contact(&mut self, points: &[ContactPoint], sols: &[PointSolution]) {
         for nodes in &mut self.contact {
             for n in nodes.iter_mut() {
-                *n = NodeContact { gap: f64::NAN, ..Default::default() };
+                *n = NodeContact {
+                    gap: f64::NAN,
+                    ..Default::default()
+                };
             }
         }
         for (pt, sol) in points.iter().zip(sols) {
             let f = &pt.frame;
             let r = sol.r();
-            let global = |v: [f64; 3]| -> [f64; 3] { std::array::from_fn(|k| v[0] * f[0][k] + v[1] * f[1][k] + v[2] * f[2][k]) };
+            let global = |v: [f64; 3]| -> [f64; 3] {
+                std::array::from_fn(|k| v[0] * f[0][k] + v[1] * f[1][k] + v[2] * f[2][k])
+            };
             self.contact[pt.pair][pt.local] = NodeContact {
                 beta: sol.beta,
                 ut: global([sol.ut[0], sol.ut[1], 0.0]),
@@ -388,7 +412,10 @@ impl Stepper {
                 let c = &self.contact[pt.pair][pt.local];
                 let f = &pt.frame;
                 let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-                BondState { beta: c.beta, ut: [dot(c.ut, f[0]), dot(c.ut, f[1])] }
+                BondState {
+                    beta: c.beta,
+                    ut: [dot(c.ut, f[0]), dot(c.ut, f[1])],
+                }
             })
             .collect()
     }
@@ -415,7 +442,13 @@ impl Stepper {
         let points = if self.problem.contacts.is_empty() {
             Vec::new()
         } else {
-            detect(&self.problem.contacts, &self.disc.reference, u0, self.state.t, t1)
+            detect(
+                &self.problem.contacts,
+                &self.disc.reference,
+                u0,
+                self.state.t,
+                t1,
+            )
         };
         let bond0 = self.bonds_at_start(&points);
         let laws: Vec<_> = self.problem.contacts.iter().map(|c| c.law).collect();
@@ -590,7 +623,9 @@ impl Stepper {
                         [x[0] + h[0], x[1] + h[1], x[2] + h[2]]
                     })
                     .collect();
-                let sol = gauss_seidel(&points, &laws, &bond0, dt, &del, &x_free, &r_contact, &r_dry, 1e-10, 500);
+                let sol = gauss_seidel(
+                    &points, &laws, &bond0, dt, &del, &x_free, &r_contact, &r_dry, 1e-10, 500,
+                );
                 sweeps += sol.sweeps;
                 if !sol.converged {
                     return Err(format!("the contact solve did not settle in {} Gauss-Seidel sweeps (Newton iteration {iter})", sol.sweeps));
@@ -621,7 +656,9 @@ impl Stepper {
                 u[i] += du[i];
             }
             let increment = (0..n).map(|i| (u[i] - u0[i]).powi(2)).sum::<f64>().sqrt();
-            last_correction_negligible = norm(&du) <= ts.newton_tol * increment;
+            // The floor (1e-6 of the model size) covers steps in which nothing moves.
+            last_correction_negligible =
+                norm(&du) <= ts.newton_tol * increment.max(1e-6 * self.model_size);
         }
         Err(format!(
             "Newton did not converge in {} iterations",

@@ -18,29 +18,57 @@ impl Rng {
 }
 
 pub fn zero3() -> [Table; 3] {
-    [Table::constant(0.0), Table::constant(0.0), Table::constant(0.0)]
+    [
+        Table::constant(0.0),
+        Table::constant(0.0),
+        Table::constant(0.0),
+    ]
 }
 
 /// Fixes the given components of a node set at zero.
 pub fn fixed(nodes: Vec<usize>, components: [bool; 3]) -> Dirichlet {
-    Dirichlet { nodes, components, translation: zero3(), rotation: None }
+    Dirichlet {
+        nodes,
+        components,
+        translation: zero3(),
+        rotation: None,
+    }
 }
 
 /// A one-body problem with no boundary conditions yet.
-pub fn one_body(mesh: Mesh, material: Arc<dyn Hyperelastic>, density: f64, time: TimeSettings) -> Problem {
+pub fn one_body(
+    mesh: Mesh,
+    material: Arc<dyn Hyperelastic>,
+    density: f64,
+    time: TimeSettings,
+) -> Problem {
     Problem {
         name: "test".into(),
-        bodies: vec![Body { name: "body".into(), mesh, material, density, initial_velocity: [0.0; 3] }],
+        bodies: vec![Body {
+            name: "body".into(),
+            mesh,
+            material,
+            density,
+            initial_velocity: [0.0; 3],
+        }],
         dirichlet: vec![],
         loads: vec![],
         gravity: [0.0; 3],
         time,
         contacts: vec![],
         tracks: vec![],
-        output: OutputSettings { frame_interval: 0.0 },
+        output: OutputSettings {
+            frame_interval: 0.0,
+        },
     }
 }
 
 pub fn quasi_static(t_end: f64, dt: f64) -> TimeSettings {
-    TimeSettings { t_end, dt, quasi_static: true, newton_tol: 1e-12, ..TimeSettings::default() }
+    TimeSettings {
+        t_end,
+        dt,
+        quasi_static: true,
+        newton_tol: 1e-12,
+        ..TimeSettings::default()
+    }
 }

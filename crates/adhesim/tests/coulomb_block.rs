@@ -28,7 +28,8 @@ friction = {mu}
 detection_distance = 1e-3
 "#
     );
-    let problem = adhesim::scenario::parse(&text, Path::new("coulomb.toml")).expect("valid scenario");
+    let problem =
+        adhesim::scenario::parse(&text, Path::new("coulomb.toml")).expect("valid scenario");
     let nodes = (0..problem.bodies[0].mesh.num_nodes()).collect();
     (Stepper::new(Arc::new(problem)).unwrap(), nodes)
 }
@@ -64,9 +65,15 @@ fn block_slides_with_the_coulomb_acceleration() {
         let expected = 0.5 * a * 0.1f64.powi(2);
         let x = mean_x(&s, &nodes);
         // θ = 1 shifts the position by O(a·t·Δt): Δt/t = 1 % of the travel.
-        assert!((x - expected).abs() < 0.015 * expected, "g_x = {gx}, μ = {mu}: x = {x}, expected {expected}");
+        assert!(
+            (x - expected).abs() < 0.015 * expected,
+            "g_x = {gx}, μ = {mu}: x = {x}, expected {expected}"
+        );
         // The friction force is μN and opposes the motion.
         let fx: f64 = s.contact[0].iter().map(|c| c.force[0]).sum();
-        assert!((fx + mu * 1e-2).abs() < 1e-3 * 1e-2 + 1e-9, "friction force {fx}");
+        assert!(
+            (fx + mu * 1e-2).abs() < 1e-3 * 1e-2 + 1e-9,
+            "friction force {fx}"
+        );
     }
 }

@@ -18,14 +18,26 @@ fn materials() -> Vec<Box<dyn Hyperelastic>> {
 }
 
 /// Largest |K_fd − K| relative to max |K|, and the energy-force consistency error.
-fn check<const N: usize, const G: usize>(gps: &[GaussPoint<N>; G], u: &[[f64; 3]; N], mat: &dyn Hyperelastic) -> (f64, f64) {
+fn check<const N: usize, const G: usize>(
+    gps: &[GaussPoint<N>; G],
+    u: &[[f64; 3]; N],
+    mat: &dyn Hyperelastic,
+) -> (f64, f64) {
     let r = element_response(gps, u, mat, true);
     let k = r.tangent.unwrap();
-    let kmax = (0..N).flat_map(|a| (0..N).map(move |b| (a, b))).map(|(a, b)| k[a][b].abs().max()).fold(0.0, f64::max);
+    let kmax = (0..N)
+        .flat_map(|a| (0..N).map(move |b| (a, b)))
+        .map(|(a, b)| k[a][b].abs().max())
+        .fold(0.0, f64::max);
     let h = 1e-7; // displacement step [m] for elements of size ~1e-2 m: relative 1e-5
     let mut err_k: f64 = 0.0;
     let mut err_f: f64 = 0.0;
-    let fmax = r.force.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-30);
+    let fmax = r
+        .force
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, v| m.max(v.abs()))
+        .max(1e-30);
     for b in 0..N {
         for kk in 0..3 {
             let mut up = *u;
@@ -62,13 +74,17 @@ fn hex8_tangent_matches_finite_differences_of_the_internal_force() {
         });
         let gps = hex8_geometry(&x).expect("valid distorted hex");
         // Large displacements: up to 20 % of the element size.
-        let u: [[f64; 3]; 8] = std::array::from_fn(|_| std::array::from_fn(|_| 0.2 * s * rng.next()));
+        let u: [[f64; 3]; 8] =
+            std::array::from_fn(|_| std::array::from_fn(|_| 0.2 * s * rng.next()));
         for mat in materials() {
             let (ek, ef) = check(&gps, &u, mat.as_ref());
             // Central differences with h = 1e-5 relative: truncation ~1e-10, round-off
             // ~1e-16/1e-5; 1e-6 leaves a wide margin yet catches any wrong term.
             assert!(ek < 1e-6, "trial {trial} {mat:?}: tangent error {ek:e}");
-            assert!(ef < 1e-6, "trial {trial} {mat:?}: force vs energy error {ef:e}");
+            assert!(
+                ef < 1e-6,
+                "trial {trial} {mat:?}: force vs energy error {ef:e}"
+            );
         }
     }
 }
@@ -77,7 +93,12 @@ fn hex8_tangent_matches_finite_differences_of_the_internal_force() {
 fn tet4_tangent_matches_finite_differences_of_the_internal_force() {
     let mut rng = Rng(12345);
     let s = 0.01;
-    let x = [[0.0, 0.0, 0.0], [s, 0.1 * s, 0.0], [0.2 * s, s, 0.1 * s], [0.1 * s, 0.2 * s, s]];
+    let x = [
+        [0.0, 0.0, 0.0],
+        [s, 0.1 * s, 0.0],
+        [0.2 * s, s, 0.1 * s],
+        [0.1 * s, 0.2 * s, s],
+    ];
     let gps = tet4_geometry(&x).unwrap();
     let u: [[f64; 3]; 4] = std::array::from_fn(|_| std::array::from_fn(|_| 0.2 * s * rng.next()));
     for mat in materials() {

@@ -15,9 +15,22 @@ use common::*;
 fn energies(theta: f64, steps: usize) -> Vec<f64> {
     let (l, h) = (0.1, 0.01);
     let mesh = generate::block([l, h, h], [10, 2, 2]);
-    let time = TimeSettings { t_end: 1.0, dt: 1e-3, theta, xi: theta, newton_tol: 1e-12, ..TimeSettings::default() };
-    let mut p = one_body(mesh.clone(), Arc::new(LinearElastic::from_young_poisson(1e6, 0.3)), 1000.0, time);
-    p.dirichlet.push(fixed(mesh.node_sets["left"].clone(), [true; 3]));
+    let time = TimeSettings {
+        t_end: 1.0,
+        dt: 1e-3,
+        theta,
+        xi: theta,
+        newton_tol: 1e-12,
+        ..TimeSettings::default()
+    };
+    let mut p = one_body(
+        mesh.clone(),
+        Arc::new(LinearElastic::from_young_poisson(1e6, 0.3)),
+        1000.0,
+        time,
+    );
+    p.dirichlet
+        .push(fixed(mesh.node_sets["left"].clone(), [true; 3]));
     let mut s = Stepper::new(Arc::new(p)).unwrap();
     // Initial velocity ∝ (x/L)², zero on the clamped face, 1 m/s at the tip.
     for (i, x) in mesh.nodes.iter().enumerate() {
@@ -48,10 +61,20 @@ fn trapezoidal_rule_conserves_energy_of_a_linear_elastic_cantilever() {
 fn backward_euler_dissipates_energy() {
     let e = energies(1.0, 400);
     for w in e.windows(2) {
-        assert!(w[1] <= w[0] * (1.0 + 1e-12), "energy grew: {} -> {}", w[0], w[1]);
+        assert!(
+            w[1] <= w[0] * (1.0 + 1e-12),
+            "energy grew: {} -> {}",
+            w[0],
+            w[1]
+        );
     }
     // Backward Euler multiplies the energy of a mode of pulsation ω by 1/(1 + (ωΔt)²) per
     // step: for the first mode (ωΔt ≈ 0.032) that is a loss of ≈ 33 % over 400 steps, and
     // higher modes lose more.
-    assert!(e[e.len() - 1] < 0.75 * e[0], "θ = 1 should lose energy: {} -> {}", e[0], e[e.len() - 1]);
+    assert!(
+        e[e.len() - 1] < 0.75 * e[0],
+        "θ = 1 should lose energy: {} -> {}",
+        e[0],
+        e[e.len() - 1]
+    );
 }

@@ -13,7 +13,11 @@ use common::*;
 
 fn run_patch(material: Arc<dyn Hyperelastic>, a: [[f64; 3]; 3]) -> f64 {
     let mut mesh = generate::block([1.0, 1.0, 1.0], [3, 3, 3]);
-    let boundary: std::collections::BTreeSet<usize> = mesh.boundary_faces().iter().flat_map(|f| f.nodes().to_vec()).collect();
+    let boundary: std::collections::BTreeSet<usize> = mesh
+        .boundary_faces()
+        .iter()
+        .flat_map(|f| f.nodes().to_vec())
+        .collect();
     let mut rng = Rng(777);
     let h = 1.0 / 3.0;
     for i in 0..mesh.num_nodes() {
@@ -23,14 +27,18 @@ fn run_patch(material: Arc<dyn Hyperelastic>, a: [[f64; 3]; 3]) -> f64 {
             }
         }
     }
-    let field = |x: [f64; 3]| -> [f64; 3] { std::array::from_fn(|i| (0..3).map(|j| a[i][j] * x[j]).sum()) };
+    let field =
+        |x: [f64; 3]| -> [f64; 3] { std::array::from_fn(|i| (0..3).map(|j| a[i][j] * x[j]).sum()) };
     let mut p = one_body(mesh.clone(), material, 1000.0, quasi_static(1.0, 1.0));
     for &n in &boundary {
         let u = field(mesh.nodes[n]);
         p.dirichlet.push(Dirichlet {
             nodes: vec![n],
             components: [true; 3],
-            translation: u.map(|v| Table { t: vec![0.0, 1.0], v: vec![0.0, v] }),
+            translation: u.map(|v| Table {
+                t: vec![0.0, 1.0],
+                v: vec![0.0, v],
+            }),
             rotation: None,
         });
     }
@@ -50,7 +58,10 @@ fn run_patch(material: Arc<dyn Hyperelastic>, a: [[f64; 3]; 3]) -> f64 {
 fn linear_elastic_patch_reproduces_a_linear_field() {
     let a = [[1e-3, 2e-4, 0.0], [0.0, -5e-4, 3e-4], [1e-4, 0.0, 2e-3]];
     let err = run_patch(Arc::new(LinearElastic::from_young_poisson(1e6, 0.3)), a);
-    assert!(err < 1e-13, "max nodal error {err:e} m for displacements ~1e-3 m");
+    assert!(
+        err < 1e-13,
+        "max nodal error {err:e} m for displacements ~1e-3 m"
+    );
 }
 
 #[test]

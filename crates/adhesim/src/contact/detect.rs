@@ -3,9 +3,9 @@
 //! sparse operator H (rows T₁ᵀ, T₂ᵀ, Nᵀ applied to the slave node minus the master nodes
 //! weighted by their shape functions at the projection).
 
+use super::law::InterfaceLaw;
 use crate::mesh::Face;
 use crate::problem::{rotate, Rotation, Table};
-use super::law::InterfaceLaw;
 use std::collections::HashMap;
 
 /// An analytic rigid surface, in its reference position. Slave nodes must stay on the side
@@ -212,7 +212,13 @@ impl ContactPoint {
 
 /// Detects the contact points of all pairs at the start of a step [t0, t1] from the
 /// displacement `u0`.
-pub fn detect(pairs: &[ContactPair], reference: &[[f64; 3]], u0: &[f64], t0: f64, t1: f64) -> Vec<ContactPoint> {
+pub fn detect(
+    pairs: &[ContactPair],
+    reference: &[[f64; 3]],
+    u0: &[f64],
+    t0: f64,
+    t1: f64,
+) -> Vec<ContactPoint> {
     let pos = |n: usize| -> [f64; 3] { std::array::from_fn(|k| reference[n][k] + u0[3 * n + k]) };
     let mut out = Vec::new();
     for (pi, pair) in pairs.iter().enumerate() {
@@ -260,7 +266,8 @@ pub fn detect(pairs: &[ContactPair], reference: &[[f64; 3]], u0: &[f64], t0: f64
                             continue;
                         }
                         if best.as_ref().map_or(true, |b| dist < b.0) {
-                            let nodes: Vec<(usize, f64)> = face.nodes().iter().copied().zip(weights).collect();
+                            let nodes: Vec<(usize, f64)> =
+                                face.nodes().iter().copied().zip(weights).collect();
                             best = Some((dist, normal, nodes, xm));
                         }
                     }
@@ -294,16 +301,36 @@ pub fn rigid_projection(shape: &RigidShape, x: [f64; 3]) -> ([f64; 3], [f64; 3],
         RigidShape::Sphere { center, radius } => {
             let d = sub(x, *center);
             let r = norm(d);
-            let n = if r > 0.0 { d.map(|v| v / r) } else { [0.0, 1.0, 0.0] };
-            (std::array::from_fn(|k| center[k] + radius * n[k]), n, r - radius)
+            let n = if r > 0.0 {
+                d.map(|v| v / r)
+            } else {
+                [0.0, 1.0, 0.0]
+            };
+            (
+                std::array::from_fn(|k| center[k] + radius * n[k]),
+                n,
+                r - radius,
+            )
         }
-        RigidShape::Cylinder { point, axis, radius } => {
+        RigidShape::Cylinder {
+            point,
+            axis,
+            radius,
+        } => {
             let d = sub(x, *point);
             let along = dot(d, *axis);
             let radial: [f64; 3] = std::array::from_fn(|k| d[k] - along * axis[k]);
             let r = norm(radial);
-            let n = if r > 0.0 { radial.map(|v| v / r) } else { [0.0, 1.0, 0.0] };
-            (std::array::from_fn(|k| point[k] + along * axis[k] + radius * n[k]), n, r - radius)
+            let n = if r > 0.0 {
+                radial.map(|v| v / r)
+            } else {
+                [0.0, 1.0, 0.0]
+            };
+            (
+                std::array::from_fn(|k| point[k] + along * axis[k] + radius * n[k]),
+                n,
+                r - radius,
+            )
         }
     }
 }
@@ -311,16 +338,37 @@ pub fn rigid_projection(shape: &RigidShape, x: [f64; 3]) -> ([f64; 3], [f64; 3],
 /// Closest-point projection of `x` on a face (bilinear quad by Newton in (ξ, η), clamped to
 /// the face; linear triangle in closed form); returns the point, the face's unit normal
 /// there and the nodal weights.
-pub fn project_on_face(face: &Face, pos: &dyn Fn(usize) -> [f64; 3], x: [f64; 3]) -> ([f64; 3], [f64; 3], Vec<f64>) {
+pub fn project_on_face(
+    face: &Face,
+    pos: &dyn Fn(usize) -> [f64; 3],
+    x: [f64; 3],
+) -> ([f64; 3], [f64; 3], Vec<f64>) {
     match face {
         Face::Quad(ns) => {
             let p: [[f64; 3]; 4] = ns.map(pos);
             let (mut a, mut b) = (0.0f64, 0.0f64);
             let eval = |a: f64, b: f64| {
-                let w = [0.25 * (1.0 - a) * (1.0 - b), 0.25 * (1.0 + a) * (1.0 - b), 0.25 * (1.0 + a) * (1.0 + b), 0.25 * (1.0 - a) * (1.0 + b)];
-                let da = [-0.25 * (1.0 - b), 0.25 * (1.0 - b), 0.25 * (1.0 + b), -0.25 * (1.0 + b)];
-                let db = [-0.25 * (1.0 - a), -0.25 * (1.0 + a), 0.25 * (1.0 + a), 0.25 * (1.0 - a)];
-                let comb = |c: [f64; 4]| -> [f64; 3] { std::array::from_fn(|k| (0..4).map(|i| c[i] * p[i][k]).sum()) };
+                let w = [
+                    0.25 * (1.0 - a) * (1.0 - b),
+                    0.25 * (1.0 + a) * (1.0 - b),
+                    0.25 * (1.0 + a) * (1.0 + b),
+                    0.25 * (1.0 - a) * (1.0 + b),
+                ];
+                let da = [
+                    -0.25 * (1.0 - b),
+                    0.25 * (1.0 - b),
+                    0.25 * (1.0 + b),
+                    -0.25 * (1.0 + b),
+                ];
+                let db = [
+                    -0.25 * (1.0 - a),
+                    -0.25 * (1.0 + a),
+                    0.25 * (1.0 + a),
+                    0.25 * (1.0 - a),
+                ];
+                let comb = |c: [f64; 4]| -> [f64; 3] {
+                    std::array::from_fn(|k| (0..4).map(|i| c[i] * p[i][k]).sum())
+                };
                 (w, comb(w), comb(da), comb(db))
             };
             for _ in 0..20 {
@@ -393,7 +441,10 @@ impl FaceGrid {
                 (lo, hi)
             })
             .collect();
-        let mean = boxes.iter().map(|(l, h)| (0..3).map(|k| h[k] - l[k]).fold(0.0, f64::max)).sum::<f64>()
+        let mean = boxes
+            .iter()
+            .map(|(l, h)| (0..3).map(|k| h[k] - l[k]).fold(0.0, f64::max))
+            .sum::<f64>()
             / boxes.len().max(1) as f64;
         let cell = mean.max(1e-12);
         let mut map: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
@@ -421,7 +472,11 @@ impl FaceGrid {
 /// (so that for normals in the x-y plane of a plane-strain slab T₁ lies in that plane), or
 /// N × e_x when N is close to e_z.
 pub fn frame_from_normal(n: [f64; 3]) -> [[f64; 3]; 3] {
-    let t1 = if n[2].abs() < 0.9 { normalize(cross(n, [0.0, 0.0, 1.0])) } else { normalize(cross(n, [1.0, 0.0, 0.0])) };
+    let t1 = if n[2].abs() < 0.9 {
+        normalize(cross(n, [0.0, 0.0, 1.0]))
+    } else {
+        normalize(cross(n, [1.0, 0.0, 0.0]))
+    };
     let t2 = cross(n, t1);
     [t1, t2, n]
 }
@@ -436,7 +491,11 @@ pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 pub(crate) fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()

@@ -18,7 +18,11 @@ pub struct Delassus {
 
 /// Builds K̄⁻¹Hᵀ and W with the current factorisation; constrained unknowns get no contact
 /// force.
-pub fn delassus(points: &[ContactPoint], chol: &mut SparseCholesky, constrained: &[bool]) -> Delassus {
+pub fn delassus(
+    points: &[ContactPoint],
+    chol: &mut SparseCholesky,
+    constrained: &[bool],
+) -> Delassus {
     let n = constrained.len();
     let m = 3 * points.len();
     let mut z = vec![0.0; n * m];
@@ -88,7 +92,9 @@ pub fn gauss_seidel(
     let mut sols: Vec<Option<PointSolution>> = vec![None; np];
     let mut dry: Vec<[f64; 3]> = dry_start.to_vec();
     let blocks: Vec<[[f64; 3]; 3]> = (0..np)
-        .map(|p| std::array::from_fn(|a| std::array::from_fn(|c| del.w[(3 * p + a) * m + 3 * p + c])))
+        .map(|p| {
+            std::array::from_fn(|a| std::array::from_fn(|c| del.w[(3 * p + a) * m + 3 * p + c]))
+        })
         .collect();
     let rhos: Vec<f64> = blocks.iter().map(|b| default_rho(*b)).collect();
     let mut converged = false;
@@ -137,5 +143,12 @@ pub fn gauss_seidel(
             break;
         }
     }
-    ContactSolution { points: sols.into_iter().map(|s| s.expect("every point solved")).collect(), sweeps, converged }
+    ContactSolution {
+        points: sols
+            .into_iter()
+            .map(|s| s.expect("every point solved"))
+            .collect(),
+        sweeps,
+        converged,
+    }
 }

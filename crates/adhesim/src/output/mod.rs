@@ -211,11 +211,19 @@ struct ContactFrame {
     state: Vec<i32>,
 }
 
-fn contact_frame(pair: &crate::contact::ContactPair, nodes: &[NodeContact], view: &StepView) -> ContactFrame {
+fn contact_frame(
+    pair: &crate::contact::ContactPair,
+    nodes: &[NodeContact],
+    view: &StepView,
+) -> ContactFrame {
     let u = &view.state.u;
     let x = &view.disc.reference;
     let mut f = ContactFrame {
-        points: pair.slave_nodes.iter().map(|&n| std::array::from_fn(|k| x[n][k] + u[3 * n + k])).collect(),
+        points: pair
+            .slave_nodes
+            .iter()
+            .map(|&n| std::array::from_fn(|k| x[n][k] + u[3 * n + k]))
+            .collect(),
         vertices: (0..pair.slave_nodes.len()).collect(),
         beta: nodes.iter().map(|c| c.beta).collect(),
         rn: nodes.iter().map(|c| c.r_dry[2] + c.r_adh[2]).collect(),
@@ -225,13 +233,17 @@ fn contact_frame(pair: &crate::contact::ContactPair, nodes: &[NodeContact], view
         rt_adh: Vec::new(),
         force: nodes.iter().map(|c| c.force).collect(),
         gap: nodes.iter().map(|c| c.gap).collect(),
-        slip: nodes.iter().map(|c| (c.slip[0].powi(2) + c.slip[1].powi(2)).sqrt()).collect(),
+        slip: nodes
+            .iter()
+            .map(|c| (c.slip[0].powi(2) + c.slip[1].powi(2)).sqrt())
+            .collect(),
         ut: nodes.iter().map(|c| c.ut).collect(),
         state: nodes.iter().map(|c| c.state).collect(),
     };
     for c in nodes {
         let t = c.tangent_axes;
-        let g = |v: [f64; 2]| -> [f64; 3] { std::array::from_fn(|k| v[0] * t[0][k] + v[1] * t[1][k]) };
+        let g =
+            |v: [f64; 2]| -> [f64; 3] { std::array::from_fn(|k| v[0] * t[0][k] + v[1] * t[1][k]) };
         f.rt.push(g([c.r_dry[0] + c.r_adh[0], c.r_dry[1] + c.r_adh[1]]));
         f.rt_adh.push(g([c.r_adh[0], c.r_adh[1]]));
     }
@@ -281,15 +293,18 @@ pub fn history_columns(problem: &Problem) -> Vec<String> {
 }
 
 /// Contact fields written for a tracked node that is a slave node of a pair.
-const CONTACT_TRACK_FIELDS: [&str; 9] = ["beta", "rn", "rn_dry", "rn_adh", "rt", "rt_adh", "gap", "slip", "state"];
+const CONTACT_TRACK_FIELDS: [&str; 9] = [
+    "beta", "rn", "rn_dry", "rn_adh", "rt", "rt_adh", "gap", "slip", "state",
+];
 
 /// (pair, index within the pair) of a tracked node that is a slave node.
 fn track_contact(problem: &Problem, node: usize) -> Option<(usize, usize)> {
-    problem
-        .contacts
-        .iter()
-        .enumerate()
-        .find_map(|(p, c)| c.slave_nodes.iter().position(|&n| n == node).map(|i| (p, i)))
+    problem.contacts.iter().enumerate().find_map(|(p, c)| {
+        c.slave_nodes
+            .iter()
+            .position(|&n| n == node)
+            .map(|i| (p, i))
+    })
 }
 
 impl HistoryObserver {
