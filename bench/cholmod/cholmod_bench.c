@@ -12,7 +12,9 @@
  *
  * For every requested ordering (metis, given, nesdis, amd) and mode (supernodal,
  * simplicial) the matrix is analysed once, then cholmod_l_factorize is timed over
- * --reps repetitions (after one warm-up call) for every requested BLAS thread count.
+ * --reps repetitions (after one warm-up call) for every requested BLAS thread count
+ * (simplicial: first thread count only, as it does not use the BLAS). For the METIS
+ * ordering the driver also reports which mode CHOLMOD's default (CHOLMOD_AUTO) selects.
  * One line per configuration is printed:
  *
  *   result ordering=metis mode=supernodal threads=1 median_s=... min_s=... ...
@@ -288,8 +290,27 @@ static void run_configuration(const options *o, const matrix_file *m, cholmod_sp
         return;
     }
 
+    if (supernodal && wanted != CHOLMOD_GIVEN) {
+        /* What CHOLMOD's default (CHOLMOD_AUTO) would choose with this ordering. */
+        cholmod_common a;
+        cholmod_l_start(&a);
+        a.print = 0;
+        a.nmethods = 1;
+        a.method[0].ordering = c.method[0].ordering;
+        cholmod_factor *La = cholmod_l_analyze(A, &a);
+        if (La) {
+            printf("note ordering=%s auto_mode=%s flops_per_lnz=%.1f supernodal_switch=%.0f\n",
+                   ordering_label(La->ordering), La->is_super ? "supernodal" : "simplicial",
+                   a.fl / a.lnz, a.supernodal_switch);
+            cholmod_l_free_factor(&La, &a);
+        }
+        cholmod_l_finish(&a);
+    }
+
+    /* The simplicial factorisation does not call the BLAS: one thread count suffices. */
+    int n_threads = supernodal ? o->n_threads : 1;
     double *samples = malloc(sizeof(double) * (size_t)o->reps);
-    for (int ti = 0; ti < o->n_threads; ti++) {
+    for (int ti = 0; ti < n_threads; ti++) {
         int threads = o->threads[ti];
         int controlled = set_threads(threads);
         if (!controlled && threads > 1) {

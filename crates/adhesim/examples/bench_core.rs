@@ -56,8 +56,9 @@ Options:
   --cholmod PATH            CHOLMOD driver (bench/cholmod/cholmod_bench); omit to skip
   --cholmod-orderings LIST  orderings given to the driver (default metis,given)
   --cholmod-modes LIST      CHOLMOD modes (default supernodal,simplicial)
-  --simplicial-max-gflop X  skip CHOLMOD simplicial above this flop count (default 10)
-  --data-dir DIR            where matrices are exported (default bench/data)
+  --given-max-size N        CHOLMOD with faer's elimination order only up to N³ (default 30)
+  --simplicial-max-gflop X  skip CHOLMOD simplicial above this flop count (default 15)
+  --data-dir DIR            where matrices are exported (default: a temporary directory)
   --keep-data               keep the exported matrices
   --micro-iters N           element calls per microbenchmark repetition (default 20000)
   --dynamic-size N          mesh of the dynamic case (default 20; 0 skips it)
@@ -72,6 +73,7 @@ struct Config {
     cholmod: Option<PathBuf>,
     cholmod_orderings: String,
     cholmod_modes: String,
+    given_max_size: usize,
     simplicial_max_gflop: f64,
     data_dir: PathBuf,
     keep_data: bool,
@@ -97,7 +99,6 @@ fn fail(msg: &str) -> ! {
 }
 
 fn parse_args() -> Config {
-    let bench_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../bench");
     let mut c = Config {
         sizes: vec![20, 30, 40],
         reps: 5,
@@ -105,8 +106,9 @@ fn parse_args() -> Config {
         cholmod: None,
         cholmod_orderings: "metis,given".into(),
         cholmod_modes: "supernodal,simplicial".into(),
-        simplicial_max_gflop: 10.0,
-        data_dir: bench_dir.join("data"),
+        given_max_size: 30,
+        simplicial_max_gflop: 15.0,
+        data_dir: std::env::temp_dir().join("adhesim-bench"),
         keep_data: false,
         micro_iters: 20_000,
         dynamic_size: 20,
@@ -141,6 +143,7 @@ fn parse_args() -> Config {
             "--cholmod" => c.cholmod = Some(PathBuf::from(value)),
             "--cholmod-orderings" => c.cholmod_orderings = value,
             "--cholmod-modes" => c.cholmod_modes = value,
+            "--given-max-size" => c.given_max_size = number(&value),
             "--simplicial-max-gflop" => {
                 c.simplicial_max_gflop = value
                     .parse()
@@ -257,6 +260,7 @@ struct CholmodRun {
     info: BTreeMap<String, String>,
     results: Vec<BTreeMap<String, String>>,
     notes: Vec<String>,
+    auto_modes: Vec<BTreeMap<String, String>>,
 }
 
 impl CholmodRun {
@@ -405,13 +409,18 @@ fn parse_driver_line(line: &str) -> Option<(String, BTreeMap<String, String>)> {
     Some((kind, fields))
 }
 
-fn run_cholmod(cfg: &Config, driver: &Path, matrix: &Path) -> CholmodRun {
+fn run_cholmod(cfg: &Config, driver: &Path, matrix: &Path, n: usize) -> CholmodRun {
     let threads: Vec<String> = cfg.threads.iter().map(|t| t.to_string()).collect();
+    let orderings: Vec<&str> = cfg
+        .cholmod_orderings
+        .split(',')
+        .filter(|o| *o != "given" || n <= cfg.given_max_size)
+        .collect();
     let output = Command::new(driver)
         .arg(matrix)
         .args(["--reps", &cfg.reps.to_string()])
         .args(["--threads", &threads.join(",")])
-        .args(["--orderings", &cfg.cholmod_orderings])
+        .args(["--orderings", &orderings.join(",")])
         .args(["--modes", &cfg.cholmod_modes])
         .args([
             "--simplicial-max-gflop",
@@ -430,6 +439,9 @@ fn run_cholmod(cfg: &Config, driver: &Path, matrix: &Path) -> CholmodRun {
         match parse_driver_line(line) {
             Some((kind, fields)) if kind == "info" => run.info = fields,
             Some((kind, fields)) if kind == "result" => run.results.push(fields),
+            Some((kind, fields)) if kind == "note" && fields.contains_key("auto_mode") => {
+                run.auto_modes.push(fields)
+            }
             Some(_) => run.notes.push(line.to_string()),
             None => {}
         }
@@ -555,7 +567,7 @@ fn bench_size(cfg: &Config, n: usize) -> SizeResult {
         let path = cfg.data_dir.join(format!("kbar_{n}.bin"));
         export_matrix(&path, pattern, &kbar, &elimination_order)
             .unwrap_or_else(|e| fail(&format!("cannot write {}: {e}", path.display())));
-        let run = run_cholmod(cfg, driver, &path);
+        let run = run_cholmod(cfg, driver, &path, n);
         if !cfg.keep_data {
             let _ = std::fs::remove_file(&path);
         }
@@ -713,6 +725,12 @@ fn opt(v: Option<f64>, fmt: impl Fn(f64) -> String) -> String {
     v.map(fmt).unwrap_or_else(|| "—".into())
 }
 
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|_| "?".into())
+}
+
 fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()
@@ -727,6 +745,7 @@ fn cpu_model() -> String {
 
 fn report(
     cfg: &Config,
+    load: (&str, &str),
     sizes: &[SizeResult],
     micro: &MicroResult,
     dynamic: Option<&DynamicResult>,
@@ -741,6 +760,11 @@ fn report(
          warm-up.",
         cpu_model(),
         cfg.reps
+    );
+    let _ = writeln!(
+        s,
+        "Load average (1, 5, 15 min) at the start: {}; at the end: {}.",
+        load.0, load.1
     );
     if let Some(info) = sizes
         .iter()
@@ -880,6 +904,28 @@ fn report(
         }
     }
 
+    let auto: Vec<String> = sizes
+        .iter()
+        .filter_map(|r| {
+            let a = r.cholmod.as_ref()?.auto_modes.first()?;
+            Some(format!(
+                "{}³: {} (flops/nnz(L) = {})",
+                r.n,
+                a.get("auto_mode").map_or("?", String::as_str),
+                a.get("flops_per_lnz").map_or("?", String::as_str)
+            ))
+        })
+        .collect();
+    if !auto.is_empty() {
+        let _ = writeln!(
+            s,
+            "\nMode chosen by CHOLMOD's default (CHOLMOD_AUTO, supernodal when flops/nnz(L) ≥ 40) \
+             with the METIS ordering: {}. The simplicial factorisation does not use the BLAS and \
+             is timed on 1 thread only, and only below the flop limit.",
+            auto.join("; ")
+        );
+    }
+
     if let Some(d) = dynamic {
         let n_steps = d.iterations.len();
         let total: usize = d.iterations.iter().sum();
@@ -988,6 +1034,7 @@ fn report(
 fn main() {
     let cfg = parse_args();
     let started = Instant::now();
+    let load_start = load_average();
     eprintln!("element microbenchmark");
     let micro = bench_element(&cfg);
     let sizes: Vec<SizeResult> = cfg.sizes.iter().map(|&n| bench_size(&cfg, n)).collect();
@@ -996,7 +1043,14 @@ fn main() {
         eprintln!("dynamic case {}³, {} thread(s)", cfg.dynamic_size, threads);
         bench_dynamic(cfg.dynamic_size, cfg.dynamic_steps, threads)
     });
-    let text = report(&cfg, &sizes, &micro, dynamic.as_ref());
+    let load_end = load_average();
+    let text = report(
+        &cfg,
+        (&load_start, &load_end),
+        &sizes,
+        &micro,
+        dynamic.as_ref(),
+    );
     print!("{text}");
     eprintln!(
         "total benchmark time {:.0} s",

@@ -75,6 +75,21 @@ pub struct StepReport {
     pub contact_sweeps: usize,
     /// Contact candidates of the step.
     pub contact_points: usize,
+    /// Wall time of the successful attempt, by phase [s].
+    pub timings: PhaseTimes,
+}
+
+/// Wall time spent in each phase of a step [s].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PhaseTimes {
+    /// Element loops: internal force and tangent.
+    pub assembly: f64,
+    /// Numeric factorisation of K̄ and the free solve.
+    pub factorisation: f64,
+    /// Contact detection and the Delassus operator W = H K̄⁻¹ Hᵀ.
+    pub delassus: f64,
+    /// Gauss-Seidel over contact points.
+    pub contact_solve: f64,
 }
 
 /// The contact state of one slave node, committed at the end of every step.
@@ -151,6 +166,7 @@ struct Attempt {
     points: Vec<ContactPoint>,
     solutions: Vec<PointSolution>,
     sweeps: usize,
+    timings: PhaseTimes,
 }
 
 impl Stepper {
@@ -322,7 +338,8 @@ impl Stepper {
             match self.attempt(dt) {
                 Ok(a) => {
                     self.commit_contact(&a.points, &a.solutions);
-                    let (contact_sweeps, contact_points) = (a.sweeps, a.points.len());
+                    let (contact_sweeps, contact_points, timings) =
+                        (a.sweeps, a.points.len(), a.timings);
                     self.commit(a.u, a.v, dt);
                     self.external_work += a.work;
                     self.last_internal = a.internal;
@@ -354,6 +371,7 @@ impl Stepper {
                         external_work: self.external_work,
                         contact_sweeps,
                         contact_points,
+                        timings,
                     });
                 }
                 Err(reason) => {
@@ -439,6 +457,8 @@ impl Stepper {
         let u0 = &self.state.u;
         let v0 = &self.state.v;
         let f_ext1 = self.external_force(t1);
+        let mut timings = PhaseTimes::default();
+        let clock = std::time::Instant::now();
         let points = if self.problem.contacts.is_empty() {
             Vec::new()
         } else {
@@ -457,6 +477,7 @@ impl Stepper {
         let mut solutions: Vec<PointSolution> = Vec::new();
         let mut sweeps = 0;
         let mut contact_force = vec![0.0; n];
+        timings.delassus += clock.elapsed().as_secs_f64();
         // Predictor: constant velocity for dynamics, last state for quasi-static.
         let mut u: Vec<f64> = if qs {
             u0.clone()
@@ -492,7 +513,9 @@ impl Stepper {
         let mut kbar = vec![0.0; self.disc.pattern.nnz()];
         let mut last_correction_negligible = false;
         for iter in 1..=ts.max_newton {
+            let clock = std::time::Instant::now();
             let asm = self.disc.assemble(&u, true);
+            timings.assembly += clock.elapsed().as_secs_f64();
             if !(asm.min_j > 0.0) || !asm.energy.is_finite() {
                 return Err(format!(
                     "an element inverted (min det F = {:.3e}) at Newton iteration {iter}",
@@ -555,7 +578,11 @@ impl Stepper {
             // correction was negligible against the step's displacement increment (the
             // residual can sit at its round-off floor when every force is small, e.g. a
             // vibrating body passing through its rest position).
-            if rel <= ts.newton_tol || gnorm == 0.0 || last_correction_negligible {
+            // With contact candidates, the contact problem must have been solved at least once.
+            let contact_solved = points.is_empty() || iter > 1;
+            if contact_solved
+                && (rel <= ts.newton_tol || gnorm == 0.0 || last_correction_negligible)
+            {
                 let du: Vec<f64> = (0..n).map(|i| u[i] - u0[i]).collect();
                 let mut work = 0.0;
                 for i in 0..n {
@@ -582,11 +609,13 @@ impl Stepper {
                     points,
                     solutions,
                     sweeps,
+                    timings,
                 });
             }
             if iter == ts.max_newton {
                 break;
             }
+            let clock = std::time::Instant::now();
             // K̄ = c_stiff K + c_damp A + c_mass M.
             for (q, k) in kbar.iter_mut().enumerate() {
                 *k = c_stiff * asm.tangent[q] + c_mass * self.mass[q];
@@ -612,7 +641,9 @@ impl Stepper {
                 .map_err(|e| format!("{e} (Newton iteration {iter})"))?;
             let mut du: Vec<f64> = g.iter().map(|x| -x).collect();
             self.chol.solve_in_place(&mut du);
+            timings.factorisation += clock.elapsed().as_secs_f64();
             if !points.is_empty() {
+                let clock = std::time::Instant::now();
                 // Reduced contact system: x = x(u) + H Δu_free + W r.
                 let del = delassus(&points, &mut self.chol, &self.constrained);
                 let x_free: Vec<[f64; 3]> = points
@@ -623,10 +654,13 @@ impl Stepper {
                         [x[0] + h[0], x[1] + h[1], x[2] + h[2]]
                     })
                     .collect();
+                timings.delassus += clock.elapsed().as_secs_f64();
+                let clock = std::time::Instant::now();
                 let sol = gauss_seidel(
                     &points, &laws, &bond0, dt, &del, &x_free, &r_contact, &r_dry, 1e-10, 500,
                 );
                 sweeps += sol.sweeps;
+                timings.contact_solve += clock.elapsed().as_secs_f64();
                 if !sol.converged {
                     return Err(format!("the contact solve did not settle in {} Gauss-Seidel sweeps (Newton iteration {iter})", sol.sweeps));
                 }

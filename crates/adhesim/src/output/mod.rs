@@ -274,6 +274,14 @@ pub fn history_columns(problem: &Problem) -> Vec<String> {
     .collect();
     c.push("contact_sweeps".into());
     c.push("contact_points".into());
+    for f in [
+        "time_assembly",
+        "time_factorisation",
+        "time_delassus",
+        "time_contact_solve",
+    ] {
+        c.push(f.into());
+    }
     for pair in &problem.contacts {
         for f in ["fx", "fy", "fz", "fn", "fn_adh", "ft", "ft_adh", "bonded"] {
             c.push(format!("{}.{f}", pair.name));
@@ -333,6 +341,8 @@ impl Observer for HistoryObserver {
         ];
         row.push(r.contact_sweeps as f64);
         row.push(r.contact_points as f64);
+        let tm = &r.timings;
+        row.extend_from_slice(&[tm.assembly, tm.factorisation, tm.delassus, tm.contact_solve]);
         for nodes in view.contact {
             let mut total = [0.0; 3];
             let (mut fn_, mut fn_adh, mut ft, mut ft_adh, mut bonded) = (0.0, 0.0, 0.0, 0.0, 0.0);
