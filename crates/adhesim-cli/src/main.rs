@@ -39,6 +39,13 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Draw figures (PNG) from a finished run's history.csv into DIR/figures/: one per
+    /// tracked quantity (displacements, β, contact and adhesive forces) with one curve per
+    /// tracked node, and one per contact-pair total.
+    Plot {
+        /// Output directory of a run (holds history.csv).
+        dir: PathBuf,
+    },
     /// Validate a scenario without running it: parse, check every value, build the meshes
     /// and check them for inverted elements. Exit code 0 when valid, 2 otherwise.
     Check {
@@ -56,6 +63,15 @@ fn main() -> ExitCode {
             quiet,
         } => run(&scenario, out, quiet),
         Command::Check { scenario } => check(&scenario),
+        Command::Plot { dir } => match adhesim::output::figures::draw_history_figures(&dir) {
+            Ok(files) => {
+                for f in files {
+                    println!("{}", f.display());
+                }
+                ExitCode::SUCCESS
+            }
+            Err(e) => fail_input(e),
+        },
     }
 }
 

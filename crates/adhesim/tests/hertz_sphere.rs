@@ -7,7 +7,11 @@ use std::sync::Arc;
 use std::time::Instant;
 
 const R: f64 = 0.01;
-const D_IND: f64 = 2.5e-5;
+fn d_ind() -> f64 {
+    std::env::var("HZD")
+        .map(|v| v.parse().unwrap())
+        .unwrap_or(2.5e-5)
+}
 const G: f64 = 1.0e6;
 
 fn grading(h: f64, fine: f64, q: f64, total: f64) -> Vec<f64> {
@@ -45,7 +49,7 @@ struct Outcome {
 }
 
 fn run(m: usize, q: f64, extent: f64, steps: usize, det: f64) -> Outcome {
-    let a = (R * D_IND).sqrt();
+    let a = (R * d_ind()).sqrt();
     let h = a / m as f64;
     let dom = extent * a;
     let g = grading(h, 1.25 * a, q, dom);
@@ -83,8 +87,8 @@ detection_distance = {det}
 "#,
         dt = 1.0 / steps as f64,
         cy = dom + R,
-        md = -D_IND,
-        det = det * D_IND,
+        md = -d_ind(),
+        det = det * d_ind(),
     );
     let mut problem =
         adhesim::scenario::parse(&text, Path::new("hertz.toml")).expect("valid scenario");
@@ -140,10 +144,10 @@ detection_distance = {det}
 
 #[test]
 fn explore() {
-    let a = (R * D_IND).sqrt();
+    let a = (R * d_ind()).sqrt();
     let e = 2.5 * G;
     let es = e / (1.0 - 0.0625);
-    let f_h = 4.0 / 3.0 * es * R.sqrt() * D_IND.powf(1.5);
+    let f_h = 4.0 / 3.0 * es * R.sqrt() * d_ind().powf(1.5);
     let args: Vec<f64> = std::env::var("HZ")
         .unwrap_or("3,1.4,40,4,0.5".into())
         .split(',')

@@ -3,6 +3,7 @@
 
 pub mod atomic;
 pub mod csv;
+pub mod figures;
 pub mod plot;
 pub mod vtk;
 

@@ -1,0 +1,86 @@
+//! Every shipped scenario runs (on a coarse setting where it is long) and gives the answer
+//! it is there to show.
+
+use adhesim::run::{run, Outcome, Silent};
+use std::path::{Path, PathBuf};
+
+fn scenario(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenarios")
+        .join(name)
+}
+
+fn column(dir: &Path, name: &str) -> Vec<f64> {
+    let (cols, rows) = adhesim::output::csv::read_history(dir.join("history.csv")).unwrap();
+    let i = cols
+        .iter()
+        .position(|c| c == name)
+        .unwrap_or_else(|| panic!("no column {name}"));
+    rows.iter().map(|r| r[i]).collect()
+}
+
+#[test]
+fn cantilever_runs_and_balances_its_energy() {
+    let path = scenario("cantilever.toml");
+    let problem = adhesim::scenario::load(&path).unwrap();
+    let out = std::env::temp_dir().join("adhesim-test-cantilever");
+    let summary = run(problem, Some(&path), &out, &mut Silent).unwrap();
+    assert_eq!(summary.outcome, Outcome::Finished);
+    assert!(out.join("cantilever.pvd").exists() && out.join("run.json").exists());
+    let uy = column(&out, "tip.uy");
+    assert!(
+        *uy.last().unwrap() < -0.01,
+        "the tip should sag under gravity and the load"
+    );
+    // Trapezoidal rule on a nonlinear (Blatz-Ko) problem: energy is conserved to the order
+    // of the time-discretisation error, well below 0.1 % of the work done.
+    let work = column(&out, "external_work");
+    let balance = column(&out, "energy_balance");
+    let w = work.last().unwrap().abs();
+    assert!(
+        balance.iter().all(|b| b.abs() < 1e-3 * w),
+        "energy balance off"
+    );
+}
+
+#[test]
+fn indentation_bonds_and_debonds_from_the_rim_inwards() {
+    let path = scenario("indentation.toml");
+    // Coarse setting for the test: a larger time step.
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("dt = 0.02", "dt = 0.05");
+    let problem = adhesim::scenario::parse(&text, &path).unwrap();
+    let out = std::env::temp_dir().join("adhesim-test-indentation");
+    let summary = run(problem, Some(&path), &out, &mut Silent).unwrap();
+    assert_eq!(summary.outcome, Outcome::Finished);
+    let t = column(&out, "t");
+    // In contact the centre bonds fully.
+    let beta_o = column(&out, "O.beta");
+    let i_hold = t.iter().position(|&x| x >= 2.0).unwrap();
+    assert!((beta_o[i_hold] - 1.0).abs() < 1e-12);
+    // On withdrawal (t > 3 s) nodes de-bond in order of their distance from the centre:
+    // the time β first falls below 0.01 decreases outwards.
+    let debond_time = |name: &str| {
+        let b = column(&out, &format!("{name}.beta"));
+        t.iter()
+            .zip(&b)
+            .find(|(ti, bi)| **ti > 3.0 && **bi < 0.01)
+            .map(|(ti, _)| *ti)
+            .unwrap_or(f64::INFINITY)
+    };
+    let times: Vec<f64> = ["n2", "n3", "A"].iter().map(|n| debond_time(n)).collect();
+    assert!(
+        times[0] > times[1] && times[1] > times[2],
+        "de-bonding times (n2, n3, A): {times:?}"
+    );
+    // The adhesive force pulls (tension) while the indentor withdraws.
+    let fn_adh = column(&out, "indentor.fn_adh");
+    let pull = fn_adh
+        .iter()
+        .zip(&t)
+        .filter(|(_, ti)| **ti > 3.0)
+        .map(|(f, _)| *f)
+        .fold(0.0, f64::min);
+    assert!(pull < -0.1, "largest adhesive pull {pull} N");
+}
