@@ -63,7 +63,7 @@ mode = "quasi-static"
 [[body]]
 name = "block"
 mesh = {{ generator = "block", size = [{dom}, {dom}, {dom}], divisions = [{n}, {n}, {n}] }}
-material = {{ model = "blatz-ko", g = {G} }}
+material = {mat}
 density = 1000.0
 [[boundary]]
 body = "block"
@@ -89,6 +89,7 @@ detection_distance = {det}
         cy = dom + R,
         md = -d_ind(),
         det = det * d_ind(),
+        mat = std::env::var("HZM").unwrap_or(format!("{{ model = \"blatz-ko\", g = {G} }}")),
     );
     let mut problem =
         adhesim::scenario::parse(&text, Path::new("hertz.toml")).expect("valid scenario");
