@@ -14,13 +14,20 @@
 //! of one numeric factorisation and of one single-right-hand-side solve (the unit costs of
 //! the alternatives to a dense W).
 //!
+//! Sizes too large to step within the time limit can be probed instead: the same case is set
+//! up and factorised, K̄⁻¹Hᵀ and W are built for a subset of the contact nodes (the cost per
+//! node is the same for every node), and Gauss-Seidel sweeps are timed on a dense W of the
+//! full size. The per-node cost times the number of contact nodes is the projected Delassus
+//! time of one Newton iteration.
+//!
 //! Each size runs in its own child process, so that peak memory is per size and an
 //! out-of-memory kill or a time-out only loses that size.
 //!
 //! Run `cargo run --release --example bench_contact -- --help` for the options.
 
 use adhesim::contact::detect::{detect, ContactPoint};
-use adhesim::contact::solve::delassus;
+use adhesim::contact::law::BondState;
+use adhesim::contact::solve::{delassus, gauss_seidel, Delassus};
 use adhesim::linalg::SparseCholesky;
 use adhesim::problem::Problem;
 use adhesim::time::{StepReport, Stepper};
@@ -50,7 +57,10 @@ bench_contact: time per step of a pad pressed on an adhesive, frictional rigid p
 
 Options:
   --sizes 9,31,70        elements per edge of the bottom face; (n+1)² contact nodes
-                         (default 9,17,31,44,54,70)
+                         (default 9,17,31,44)
+  --probe-sizes 54,70    sizes whose unit costs are probed instead of stepped
+                         (default 54,70; empty to skip)
+  --probe-points N       contact nodes of the probed K̄⁻¹Hᵀ subset (default 128)
   --layers N             element layers through the height (default 4)
   --steps N              steps per repetition (default 4)
   --reps N               repetitions per size, each from a fresh stepper (default 3)
@@ -64,11 +74,14 @@ Options:
   --no-analysis          skip the analysis of W after the timed steps
   --results PATH         also write the report (markdown) to PATH
   --single N             run one size in this process and print its result line
+  --probe N              probe one size in this process and print its result line
 ";
 
 #[derive(Clone, Debug)]
 struct Config {
     sizes: Vec<usize>,
+    probe_sizes: Vec<usize>,
+    probe_points: usize,
     layers: usize,
     steps: usize,
     reps: usize,
@@ -80,6 +93,7 @@ struct Config {
     analysis: bool,
     results: Option<PathBuf>,
     single: Option<usize>,
+    probe: Option<usize>,
 }
 
 fn fail(msg: &str) -> ! {
@@ -89,7 +103,9 @@ fn fail(msg: &str) -> ! {
 
 fn parse_args() -> Config {
     let mut cfg = Config {
-        sizes: vec![9, 17, 31, 44, 54, 70],
+        sizes: vec![9, 17, 31, 44],
+        probe_sizes: vec![54, 70],
+        probe_points: 128,
         layers: 4,
         steps: 4,
         reps: 3,
@@ -101,6 +117,7 @@ fn parse_args() -> Config {
         analysis: true,
         results: None,
         single: None,
+        probe: None,
     };
     let mut args = std::env::args().skip(1);
     while let Some(flag) = args.next() {
@@ -123,6 +140,12 @@ fn parse_args() -> Config {
                 .parse()
                 .unwrap_or_else(|_| fail(&format!("{flag}: not a whole number: {v}")))
         };
+        let list = |v: &str| -> Vec<usize> {
+            v.split(',')
+                .filter(|x| !x.trim().is_empty())
+                .map(int)
+                .collect()
+        };
         let real = |v: &str| -> f64 {
             match v.trim().parse::<f64>() {
                 Ok(x) if x.is_finite() && x > 0.0 => x,
@@ -130,7 +153,9 @@ fn parse_args() -> Config {
             }
         };
         match flag.as_str() {
-            "--sizes" => cfg.sizes = value.split(',').map(int).collect(),
+            "--sizes" => cfg.sizes = list(&value),
+            "--probe-sizes" => cfg.probe_sizes = list(&value),
+            "--probe-points" => cfg.probe_points = int(&value).max(1),
             "--layers" => cfg.layers = int(&value).max(1),
             "--steps" => cfg.steps = int(&value).max(1),
             "--reps" => cfg.reps = int(&value).max(1),
@@ -147,20 +172,26 @@ fn parse_args() -> Config {
             "--memory-fraction" => cfg.memory_fraction = real(&value),
             "--results" => cfg.results = Some(PathBuf::from(value)),
             "--single" => cfg.single = Some(int(&value)),
+            "--probe" => cfg.probe = Some(int(&value)),
             _ => fail(&format!("unknown option {flag}")),
         }
     }
-    if cfg.sizes.iter().any(|&n| n == 0) {
+    if cfg.sizes.iter().chain(&cfg.probe_sizes).any(|&n| n == 0) {
         fail("sizes must be at least 1");
     }
     cfg
 }
 
 /// The options a child process needs to reproduce the parent's case.
-fn child_args(cfg: &Config, n: usize) -> Vec<String> {
+fn child_args(cfg: &Config, kind: Kind, n: usize) -> Vec<String> {
     let mut a = vec![
-        "--single".to_string(),
+        match kind {
+            Kind::Step => "--single".to_string(),
+            Kind::Probe => "--probe".to_string(),
+        },
         n.to_string(),
+        "--probe-points".into(),
+        cfg.probe_points.to_string(),
         "--layers".into(),
         cfg.layers.to_string(),
         "--steps".into(),
@@ -312,11 +343,48 @@ struct SizeResult {
     analysis: Option<Analysis>,
 }
 
+/// Unit costs of a size that is probed rather than stepped.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+struct ProbeResult {
+    divisions: usize,
+    layers: usize,
+    dofs: usize,
+    contact_nodes: usize,
+    factor_nnz: usize,
+    threads: usize,
+    setup: f64,
+    /// Numeric factorisation of K̄ at the reference state [s] (median).
+    factorise: f64,
+    /// One solve with one right-hand side [s] (median).
+    solve_one: f64,
+    /// Contact nodes of the subset.
+    subset: usize,
+    /// K̄⁻¹Hᵀ and W for the subset [s].
+    subset_delassus: f64,
+    /// subset_delassus × contact_nodes / subset [s].
+    delassus_projected: f64,
+    /// One Gauss-Seidel sweep over all contact nodes with a dense W [s] (median).
+    gs_sweep: f64,
+    peak_rss: u64,
+}
+
+/// How a child process treats its size.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    Step,
+    Probe,
+}
+
 /// What became of one size.
 #[derive(Clone, Debug)]
 enum Outcome {
     Done(Box<SizeResult>),
-    Skipped { divisions: usize, reason: String },
+    Probed(Box<ProbeResult>),
+    Skipped {
+        kind: Kind,
+        divisions: usize,
+        reason: String,
+    },
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -380,13 +448,30 @@ fn main() {
         );
         return;
     }
+    if let Some(n) = cfg.probe {
+        let result = probe_size(&cfg, n);
+        println!(
+            "{RESULT_TAG}{}",
+            serde_json::to_string(&result).expect("serialisable result")
+        );
+        return;
+    }
     let started = Instant::now();
     let mut outcomes = Vec::new();
-    for &n in &cfg.sizes {
-        let outcome = run_child(&cfg, n);
+    let jobs = cfg
+        .sizes
+        .iter()
+        .map(|&n| (Kind::Step, n))
+        .chain(cfg.probe_sizes.iter().map(|&n| (Kind::Probe, n)));
+    for (kind, n) in jobs {
+        let outcome = run_child(&cfg, kind, n);
         match &outcome {
             Outcome::Done(r) => eprintln!(
-                "size {n}: {} contact nodes, {} DOFs done",
+                "size {n}: {} contact nodes, {} DOFs stepped",
+                r.contact_nodes, r.dofs
+            ),
+            Outcome::Probed(r) => eprintln!(
+                "size {n}: {} contact nodes, {} DOFs probed",
                 r.contact_nodes, r.dofs
             ),
             Outcome::Skipped { reason, .. } => eprintln!("size {n}: {reason}"),
@@ -405,12 +490,18 @@ fn main() {
 }
 
 /// Runs one size in a child process, within the memory and time limits.
-fn run_child(cfg: &Config, n: usize) -> Outcome {
+fn run_child(cfg: &Config, kind: Kind, n: usize) -> Outcome {
     let (dofs, nc) = mesh_counts(cfg, n);
     let (z, w) = dense_bytes(dofs, nc);
+    // A probe holds W and K̄⁻¹Hᵀ of the subset only.
+    let needed = match kind {
+        Kind::Step => z + w,
+        Kind::Probe => w + z * cfg.probe_points.min(nc) as u64 / nc.max(1) as u64,
+    };
     if let Some(avail) = available_memory() {
-        if (z + w) as f64 > cfg.memory_fraction * avail as f64 {
+        if needed as f64 > cfg.memory_fraction * avail as f64 {
             return Outcome::Skipped {
+                kind,
                 divisions: n,
                 reason: format!(
                     "skipped: K̄⁻¹Hᵀ ({:.1} GB) and W ({:.1} GB) exceed {:.0} % of the {:.1} GB available",
@@ -424,7 +515,7 @@ fn run_child(cfg: &Config, n: usize) -> Outcome {
     }
     let exe = std::env::current_exe().unwrap_or_else(|e| fail(&format!("no executable path: {e}")));
     let mut child = Command::new(exe)
-        .args(child_args(cfg, n))
+        .args(child_args(cfg, kind, n))
         .stdout(Stdio::piped())
         .stderr(Stdio::inherit())
         .spawn()
@@ -453,16 +544,25 @@ fn run_child(cfg: &Config, n: usize) -> Outcome {
         .lines()
         .map_while(Result::ok)
         .find_map(|l| {
-            l.strip_prefix(RESULT_TAG)
-                .and_then(|j| serde_json::from_str::<SizeResult>(j).ok())
+            let json = l.strip_prefix(RESULT_TAG)?;
+            match kind {
+                Kind::Step => serde_json::from_str::<SizeResult>(json)
+                    .ok()
+                    .map(|r| Outcome::Done(Box::new(r))),
+                Kind::Probe => serde_json::from_str::<ProbeResult>(json)
+                    .ok()
+                    .map(|r| Outcome::Probed(Box::new(r))),
+            }
         });
     match (status, parsed) {
-        (_, Some(r)) => Outcome::Done(Box::new(r)),
+        (_, Some(outcome)) => outcome,
         (None, None) => Outcome::Skipped {
+            kind,
             divisions: n,
             reason: format!("did not finish within {:.0} s", cfg.timeout),
         },
         (Some(status), None) => Outcome::Skipped {
+            kind,
             divisions: n,
             reason: format!("the child process failed ({status}); out of memory?"),
         },

@@ -235,26 +235,30 @@ pub fn element_response<const N: usize, const G: usize>(
         energy += material.energy(&c) * gp.weight;
         let w = gp.weight;
         let bs: [Bmat; N] = std::array::from_fn(|a| b_matrix(&fb, &gp.grad[a]));
-        if let Some(kt) = tangent.as_mut() {
+        let (s, d) = if with_tangent {
             let (s, d) = material.pk2_and_tangent(&c);
-            let sv = nalgebra::Vector6::new(
-                s[(0, 0)],
-                s[(1, 1)],
-                s[(2, 2)],
-                s[(0, 1)],
-                s[(1, 2)],
-                s[(0, 2)],
-            );
-            for a in 0..N {
-                let fa = bs[a].transpose() * sv;
-                for i in 0..3 {
-                    force[a][i] += w * fa[i];
-                }
+            (s, Some(d))
+        } else {
+            (material.pk2(&c), None)
+        };
+        let sv = nalgebra::Vector6::new(
+            s[(0, 0)],
+            s[(1, 1)],
+            s[(2, 2)],
+            s[(0, 1)],
+            s[(1, 2)],
+            s[(0, 2)],
+        );
+        for a in 0..N {
+            let fa = bs[a].transpose() * sv;
+            for i in 0..3 {
+                force[a][i] += w * fa[i];
             }
+        }
+        if let (Some(kt), Some(d)) = (tangent.as_mut(), d) {
             let dbs: [Bmat; N] = std::array::from_fn(|b| d * bs[b]);
             for a in 0..N {
-                let ga = Vec3::from(gp.grad[a]);
-                let sga = s * ga;
+                let sga = s * Vec3::from(gp.grad[a]);
                 for b in a..N {
                     let mut kab = bs[a].transpose() * dbs[b];
                     if !small {
@@ -264,22 +268,6 @@ pub fn element_response<const N: usize, const G: usize>(
                         }
                     }
                     kt[a][b] += w * kab;
-                }
-            }
-        } else {
-            let s = material.pk2(&c);
-            let sv = nalgebra::Vector6::new(
-                s[(0, 0)],
-                s[(1, 1)],
-                s[(2, 2)],
-                s[(0, 1)],
-                s[(1, 2)],
-                s[(0, 2)],
-            );
-            for a in 0..N {
-                let fa = bs[a].transpose() * sv;
-                for i in 0..3 {
-                    force[a][i] += w * fa[i];
                 }
             }
         }

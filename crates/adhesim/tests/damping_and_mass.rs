@@ -16,7 +16,14 @@ fn mass_proportional_damping_matches_the_discrete_closed_form() {
     for lumped in [false, true] {
         let (alpha, dt) = (20.0, 1e-3);
         let mesh = generate::block([0.01, 0.01, 0.01], [2, 2, 2]);
-        let time = TimeSettings { t_end: 0.05, dt, newton_tol: 1e-12, lumped_mass: lumped, rayleigh: (alpha, 0.0), ..TimeSettings::default() };
+        let time = TimeSettings {
+            t_end: 0.05,
+            dt,
+            newton_tol: 1e-12,
+            lumped_mass: lumped,
+            rayleigh: (alpha, 0.0),
+            ..TimeSettings::default()
+        };
         let mut p = one_body(mesh, Arc::new(BlatzKo { g: 1e6 }), 1000.0, time);
         p.bodies[0].initial_velocity = [0.3, -0.2, 0.1];
         let mut s = Stepper::new(Arc::new(p)).unwrap();
@@ -29,7 +36,10 @@ fn mass_proportional_damping_matches_the_discrete_closed_form() {
         let expected = 0.3 * factor.powi(steps);
         for i in 0..s.disc.num_nodes {
             let v = s.state.v[3 * i];
-            assert!((v - expected).abs() < 1e-12, "lumped = {lumped}: v = {v}, expected {expected}");
+            assert!(
+                (v - expected).abs() < 1e-12,
+                "lumped = {lumped}: v = {v}, expected {expected}"
+            );
         }
     }
 }
@@ -39,16 +49,27 @@ fn mass_proportional_damping_matches_the_discrete_closed_form() {
 #[test]
 fn mass_matrices_carry_the_total_mass() {
     let mesh = generate::disk(0.01, 0.002, 4, 3);
-    let p = one_body(mesh, Arc::new(BlatzKo { g: 1e6 }), 1200.0, TimeSettings::default());
+    let p = one_body(
+        mesh,
+        Arc::new(BlatzKo { g: 1e6 }),
+        1200.0,
+        TimeSettings::default(),
+    );
     let s = Stepper::new(Arc::new(p)).unwrap();
     let volume = s.disc.volume();
     let mass = 1200.0 * volume;
     for lumped in [false, true] {
         let m = s.disc.mass(&[1200.0], lumped);
-        let v: Vec<f64> = (0..s.disc.num_dofs()).map(|d| if d % 3 == 1 { 2.0 } else { 0.0 }).collect();
+        let v: Vec<f64> = (0..s.disc.num_dofs())
+            .map(|d| if d % 3 == 1 { 2.0 } else { 0.0 })
+            .collect();
         let mut mv = vec![0.0; v.len()];
         s.disc.pattern.symmetric_matvec(&m, &v, &mut mv);
         let ke: f64 = 0.5 * v.iter().zip(&mv).map(|(a, b)| a * b).sum::<f64>();
-        assert!((ke - 0.5 * mass * 4.0).abs() < 1e-12 * ke, "lumped = {lumped}: {ke} vs {}", 0.5 * mass * 4.0);
+        assert!(
+            (ke - 0.5 * mass * 4.0).abs() < 1e-12 * ke,
+            "lumped = {lumped}: {ke} vs {}",
+            0.5 * mass * 4.0
+        );
     }
 }

@@ -20,16 +20,7 @@ const HEX_CORNER_FRAMES: [[usize; 4]; 8] = [
 ];
 
 /// Natural coordinates (ξ, η, ζ) of the hex8 nodes (VTK order).
-const HEX_NATURAL: [[f64; 3]; 8] = [
-    [-1.0, -1.0, -1.0],
-    [1.0, -1.0, -1.0],
-    [1.0, 1.0, -1.0],
-    [-1.0, 1.0, -1.0],
-    [-1.0, -1.0, 1.0],
-    [1.0, -1.0, 1.0],
-    [1.0, 1.0, 1.0],
-    [-1.0, 1.0, 1.0],
-];
+use crate::element::HEX_NODE_XI as HEX_NATURAL;
 
 /// Minimum scaled Jacobian of every cell (hexes first, then tets), dimensionless.
 ///
