@@ -20,6 +20,7 @@
 //! - the clamped boundary at 1000 a: ≈ +0.1 % (∝ a/D: +0.35 % at D = 300 a);
 //! - discretisation: with nodal contact forces the contact edge is sampled node by node, so
 //!   the error is not monotone at the 0.1 % level once h ≤ a/4; h = a/2 is −1.3 %.
+//!
 //! The finest meshes are therefore asserted within 1 % of Hertz, the coarse one is asserted
 //! to be worse than both, and the force differences between successive meshes must shrink.
 //! The contact radius (outermost node with a positive normal force) must be within one
