@@ -508,3 +508,132 @@ pub(crate) fn normalize(a: [f64; 3]) -> [f64; 3] {
         [0.0, 1.0, 0.0]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::problem::Rotation;
+
+    #[test]
+    fn frame_is_orthonormal_and_right_handed() {
+        for n in [
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, -1.0],
+            normalize([0.3, -0.4, 0.8]),
+            normalize([1.0, 1.0, 0.0]),
+        ] {
+            let [t1, t2, nn] = frame_from_normal(n);
+            assert!((dot(t1, t1) - 1.0).abs() < 1e-14 && (dot(t2, t2) - 1.0).abs() < 1e-14);
+            assert!(
+                dot(t1, t2).abs() < 1e-14 && dot(t1, nn).abs() < 1e-14 && dot(t2, nn).abs() < 1e-14
+            );
+            let c = cross(t1, t2);
+            assert!(norm(sub(c, nn)) < 1e-14, "T1 × T2 must be N");
+        }
+        // Normals in the x-y plane of a plane-strain slab keep T1 in that plane.
+        let [t1, _, _] = frame_from_normal(normalize([0.6, 0.8, 0.0]));
+        assert!(t1[2].abs() < 1e-15);
+    }
+
+    #[test]
+    fn rigid_motion_inverse_undoes_apply() {
+        let m = RigidMotion {
+            translation: [
+                Table {
+                    t: vec![0.0, 1.0],
+                    v: vec![0.0, 0.2],
+                },
+                Table::constant(-0.1),
+                Table::constant(0.05),
+            ],
+            rotation: Some(Rotation {
+                center: [0.1, 0.2, 0.3],
+                axis: normalize([0.2, 1.0, -0.3]),
+                angle: Table {
+                    t: vec![0.0, 1.0],
+                    v: vec![0.0, 1.3],
+                },
+            }),
+        };
+        let x = [0.4, -0.7, 0.25];
+        for t in [0.0, 0.3, 1.0, 2.0] {
+            let back = m.inverse(m.apply(x, t), t);
+            assert!(norm(sub(back, x)) < 1e-14, "t = {t}");
+        }
+        // Distances between material points are preserved (rigid).
+        let y = [0.0, 0.1, -0.2];
+        let d0 = norm(sub(x, y));
+        let d1 = norm(sub(m.apply(x, 0.6), m.apply(y, 0.6)));
+        assert!((d0 - d1).abs() < 1e-14);
+    }
+
+    #[test]
+    fn rigid_shapes_give_signed_gaps_and_outward_normals() {
+        let plane = RigidShape::Plane {
+            point: [0.0, 1.0, 0.0],
+            normal: [0.0, 1.0, 0.0],
+        };
+        let (p, n, g) = rigid_projection(&plane, [0.3, 1.25, -2.0]);
+        assert_eq!((p, n), ([0.3, 1.0, -2.0], [0.0, 1.0, 0.0]));
+        assert!((g - 0.25).abs() < 1e-15);
+        let sphere = RigidShape::Sphere {
+            center: [0.0; 3],
+            radius: 2.0,
+        };
+        let (p, n, g) = rigid_projection(&sphere, [0.0, 0.0, 1.5]);
+        assert!((g + 0.5).abs() < 1e-15 && n == [0.0, 0.0, 1.0] && (p[2] - 2.0).abs() < 1e-15);
+        let cyl = RigidShape::Cylinder {
+            point: [0.0; 3],
+            axis: [0.0, 0.0, 1.0],
+            radius: 1.0,
+        };
+        let (p, n, g) = rigid_projection(&cyl, [3.0, 0.0, 7.0]);
+        assert!((g - 2.0).abs() < 1e-15 && n == [1.0, 0.0, 0.0] && p == [1.0, 0.0, 7.0]);
+    }
+
+    #[test]
+    fn closest_point_on_a_warped_quad_is_orthogonal_and_weights_interpolate() {
+        let nodes = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.1],
+            [1.2, 1.0, -0.05],
+            [0.1, 0.9, 0.0],
+        ];
+        let pos = |i: usize| nodes[i];
+        let face = Face::Quad([0, 1, 2, 3]);
+        let x = [0.55, 0.4, 0.6];
+        let (xm, n, w) = project_on_face(&face, &pos, x);
+        // The weights are partition of unity and reproduce the projected point.
+        assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-14);
+        let xi: [f64; 3] = std::array::from_fn(|k| (0..4).map(|i| w[i] * nodes[i][k]).sum());
+        assert!(norm(sub(xi, xm)) < 1e-14);
+        // x − x_m is orthogonal to the surface tangents at the projection (an interior
+        // closest point), hence parallel to the normal.
+        let d = sub(x, xm);
+        assert!(norm(cross(d, n)) < 1e-9 * norm(d), "not along the normal");
+        assert!(
+            dot(d, n) > 0.0,
+            "the point is on the outer side of a counter-clockwise face"
+        );
+        // A point beyond an edge projects onto the face boundary (clamped).
+        let (_, _, w2) = project_on_face(&face, &pos, [-1.0, 0.5, 0.0]);
+        assert!(w2[1].abs() < 1e-12 && w2[2].abs() < 1e-12);
+    }
+
+    #[test]
+    fn tributary_areas_add_up_to_the_face_area() {
+        let coords = vec![
+            [0.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [2.0, 0.0, 3.0],
+            [0.0, 0.0, 3.0],
+            [4.0, 0.0, 0.0],
+            [4.0, 0.0, 3.0],
+        ];
+        let faces = vec![Face::Quad([0, 1, 2, 3]), Face::Quad([1, 4, 5, 2])];
+        let nodes = vec![0, 1, 2, 3, 4, 5];
+        let a = tributary_areas(&faces, &coords, &nodes);
+        assert!((a.iter().sum::<f64>() - 12.0).abs() < 1e-12);
+        assert!((a[1] - 3.0).abs() < 1e-12 && (a[0] - 1.5).abs() < 1e-12);
+    }
+}
