@@ -8,6 +8,7 @@
 #   THREADS=1,2      thread counts
 #   BLAS=openblas    BLAS used by CHOLMOD: openblas (libopenblas0-pthread) or system
 #                    (whatever libblas.so.3 points to; Debian's default is the reference BLAS)
+#   DENSE=3000       size of the dense-kernel diagnostic (0 skips it)
 #   RESULTS=bench/results.md
 set -euo pipefail
 
@@ -55,4 +56,4 @@ else
 fi
 
 "$bench_core" --sizes "$sizes" --reps "$reps" --threads "$threads" \
-  "${cholmod_args[@]}" --results "$results" "$@"
+  --dense "${DENSE:-3000}" "${cholmod_args[@]}" --results "$results" "$@"

@@ -11,17 +11,24 @@
  *                                k-th pivot (the elimination order used by faer)
  *
  * For every requested ordering (metis, given, nesdis, amd) and mode (supernodal,
- * simplicial) the matrix is analysed once, then cholmod_l_factorize is timed over
- * --reps repetitions (after one warm-up call, kept as the first sample when it takes
- * more than 2 s) for every requested BLAS thread count
- * (simplicial: first thread count only, as it does not use the BLAS). For the METIS
- * ordering the driver also reports which mode CHOLMOD's default (CHOLMOD_AUTO) selects.
- * One line per configuration is printed:
+ * simplicial) the matrix is analysed once. For the METIS ordering the driver also reports
+ * which mode CHOLMOD's default (CHOLMOD_AUTO) selects. Then:
  *
- *   result ordering=metis mode=supernodal threads=1 median_s=... min_s=... ...
+ * - batch mode (default): cholmod_l_factorize is timed over --reps repetitions after one
+ *   warm-up call (kept as the first sample when it takes more than 2 s), for every
+ *   requested BLAS thread count (simplicial: first thread count only, as it does not use
+ *   the BLAS), and one line per configuration and thread count is printed:
+ *     result ordering=metis mode=supernodal analyse_s=... threads=1 median_s=... ...
+ * - --serve: the driver answers single-factorisation requests on stdin (see run_serve),
+ *   so that bench_core can alternate CHOLMOD and faer runs under the same machine load.
  *
  * Usage: cholmod_bench FILE [--reps N] [--threads 1,2] [--orderings metis,given]
  *                           [--modes supernodal,simplicial] [--simplicial-max-gflop X]
+ *                           [--serve]
+ *
+ * Diagnostic mode: cholmod_bench --dense N [--reps R] [--threads 1,2] times the BLAS/LAPACK
+ * that CHOLMOD uses on a dense N×N Cholesky (dpotrf) and product (dgemm), on the matrix
+ * that bench_core's --dense option gives to faer.
  */
 
 #include <cholmod.h>
@@ -53,6 +60,8 @@ typedef struct {
     char modes[MAX_LIST][16];
     int n_modes;
     double simplicial_max_gflop;
+    int dense;
+    int serve;
 } options;
 
 static double now_s(void) {
@@ -145,15 +154,21 @@ static options parse_options(int argc, char **argv) {
         } else if (strcmp(a, "--simplicial-max-gflop") == 0 && v) {
             o.simplicial_max_gflop = atof(v);
             i++;
+        } else if (strcmp(a, "--serve") == 0) {
+            o.serve = 1;
+        } else if (strcmp(a, "--dense") == 0 && v) {
+            o.dense = atoi(v);
+            i++;
         } else if (a[0] != '-' && !o.path) {
             o.path = a;
         } else {
             die("usage: cholmod_bench FILE [--reps N] [--threads 1,2] "
                 "[--orderings metis,given,nesdis,amd] [--modes supernodal,simplicial] "
-                "[--simplicial-max-gflop X]");
+                "[--simplicial-max-gflop X] [--serve]\n"
+                "       cholmod_bench --dense N [--reps N] [--threads 1,2]");
         }
     }
-    if (!o.path) die("missing matrix file");
+    if (!o.path && o.dense <= 0) die("missing matrix file");
     if (o.reps < 1) o.reps = 1;
     return o;
 }
@@ -246,60 +261,82 @@ static double solve_error(cholmod_sparse *A, cholmod_factor *L, cholmod_common *
     return err;
 }
 
-static void run_configuration(const options *o, const matrix_file *m, cholmod_sparse *A,
-                              const char *ordering, const char *mode) {
+/* One analysed (ordering, mode) configuration. */
+typedef struct {
+    char ordering[16]; /* the ordering CHOLMOD actually used */
+    char mode[16];
+    int supernodal;
+    cholmod_common c;
+    cholmod_factor *L;
+    double analyse_s, lnz, fl, stored, stored_flops;
+} config;
+
+/* Analyses A for one configuration; returns 0 (after printing why) when it is skipped or
+ * fails. */
+static int analyse_config(config *cf, const options *o, const matrix_file *m,
+                          cholmod_sparse *A, const char *ordering, const char *mode) {
+    memset(cf, 0, sizeof *cf);
     int wanted = ordering_code(ordering);
-    int supernodal = strcmp(mode, "supernodal") == 0;
-    if (!supernodal && strcmp(mode, "simplicial") != 0) die("unknown mode");
+    cf->supernodal = strcmp(mode, "supernodal") == 0;
+    if (!cf->supernodal && strcmp(mode, "simplicial") != 0) die("unknown mode");
+    snprintf(cf->mode, sizeof cf->mode, "%s", mode);
     if (wanted == CHOLMOD_GIVEN && !m->perm) {
         printf("skipped ordering=given mode=%s reason=no_permutation_in_file\n", mode);
-        return;
+        return 0;
     }
 
-    cholmod_common c;
-    cholmod_l_start(&c);
-    c.print = 0;
-    c.nmethods = 1;
-    c.method[0].ordering = wanted;
-    c.postorder = 1;
-    c.supernodal = supernodal ? CHOLMOD_SUPERNODAL : CHOLMOD_SIMPLICIAL;
-    c.final_ll = 1;
+    cholmod_common *c = &cf->c;
+    cholmod_l_start(c);
+    c->print = 0;
+    c->nmethods = 1;
+    c->method[0].ordering = wanted;
+    c->postorder = 1;
+    c->supernodal = cf->supernodal ? CHOLMOD_SUPERNODAL : CHOLMOD_SIMPLICIAL;
+    c->final_ll = 1;
 
     int64_t *perm = wanted == CHOLMOD_GIVEN ? m->perm : NULL;
     double t0 = now_s();
-    cholmod_factor *L = cholmod_l_analyze_p(A, perm, NULL, 0, &c);
-    double analyse_s = now_s() - t0;
-    if (!L && wanted == CHOLMOD_METIS && c.status == CHOLMOD_NOT_INSTALLED) {
+    cf->L = cholmod_l_analyze_p(A, perm, NULL, 0, c);
+    cf->analyse_s = now_s() - t0;
+    if (!cf->L && wanted == CHOLMOD_METIS && c->status == CHOLMOD_NOT_INSTALLED) {
         printf("note metis_unavailable=1 fallback=amd\n");
-        c.status = CHOLMOD_OK;
-        c.method[0].ordering = CHOLMOD_AMD;
+        c->status = CHOLMOD_OK;
+        c->method[0].ordering = CHOLMOD_AMD;
         t0 = now_s();
-        L = cholmod_l_analyze_p(A, NULL, NULL, 0, &c);
-        analyse_s = now_s() - t0;
+        cf->L = cholmod_l_analyze_p(A, NULL, NULL, 0, c);
+        cf->analyse_s = now_s() - t0;
     }
-    if (!L || c.status < CHOLMOD_OK) {
-        printf("failed ordering=%s mode=%s stage=analyse status=%d\n", ordering, mode, c.status);
-        if (L) cholmod_l_free_factor(&L, &c);
-        cholmod_l_finish(&c);
-        return;
+    if (!cf->L || c->status < CHOLMOD_OK) {
+        printf("failed ordering=%s mode=%s stage=analyse status=%d\n", ordering, mode, c->status);
+        if (cf->L) cholmod_l_free_factor(&cf->L, c);
+        cholmod_l_finish(c);
+        return 0;
     }
-    const char *used = ordering_label(L->ordering);
-    double lnz = c.lnz, fl = c.fl;
+    snprintf(cf->ordering, sizeof cf->ordering, "%s", ordering_label(cf->L->ordering));
+    cf->lnz = c->lnz;
+    cf->fl = c->fl;
+    if (cf->L->is_super) {
+        supernodal_size(cf->L, &cf->stored, &cf->stored_flops);
+    } else {
+        cf->stored = cf->lnz;
+        cf->stored_flops = cf->fl;
+    }
 
-    if (!supernodal && fl > o->simplicial_max_gflop * 1e9) {
-        printf("skipped ordering=%s mode=simplicial reason=flops_%.3g_above_limit\n", used, fl);
-        cholmod_l_free_factor(&L, &c);
-        cholmod_l_finish(&c);
-        return;
+    if (!cf->supernodal && cf->fl > o->simplicial_max_gflop * 1e9) {
+        printf("skipped ordering=%s mode=simplicial reason=flops_%.3g_above_limit\n",
+               cf->ordering, cf->fl);
+        cholmod_l_free_factor(&cf->L, c);
+        cholmod_l_finish(c);
+        return 0;
     }
 
-    if (supernodal && wanted != CHOLMOD_GIVEN) {
+    if (cf->supernodal && wanted != CHOLMOD_GIVEN) {
         /* What CHOLMOD's default (CHOLMOD_AUTO) would choose with this ordering. */
         cholmod_common a;
         cholmod_l_start(&a);
         a.print = 0;
         a.nmethods = 1;
-        a.method[0].ordering = c.method[0].ordering;
+        a.method[0].ordering = c->method[0].ordering;
         cholmod_factor *La = cholmod_l_analyze(A, &a);
         if (La) {
             printf("note ordering=%s auto_mode=%s flops_per_lnz=%.1f supernodal_switch=%.0f\n",
@@ -309,59 +346,191 @@ static void run_configuration(const options *o, const matrix_file *m, cholmod_sp
         }
         cholmod_l_finish(&a);
     }
+    return 1;
+}
 
-    /* The simplicial factorisation does not call the BLAS: one thread count suffices. */
-    int n_threads = supernodal ? o->n_threads : 1;
+static void free_config(config *cf) {
+    if (cf->L) cholmod_l_free_factor(&cf->L, &cf->c);
+    cholmod_l_finish(&cf->c);
+}
+
+/* One numeric factorisation; returns its duration [s], or a negative value on failure. */
+static double factorize_once(config *cf, cholmod_sparse *A) {
+    double t0 = now_s();
+    int ok = cholmod_l_factorize(A, cf->L, &cf->c);
+    double t = now_s() - t0;
+    if (!ok || cf->c.status != CHOLMOD_OK || cf->L->minor < A->nrow) return -1.0;
+    return t;
+}
+
+static void print_config(const config *cf, const char *prefix) {
+    printf("%s ordering=%s mode=%s analyse_s=%.6f lnz=%.0f fl=%.6e stored=%.0f "
+           "stored_flops=%.6e nsuper=%zu",
+           prefix, cf->ordering, cf->mode, cf->analyse_s, cf->lnz, cf->fl, cf->stored,
+           cf->stored_flops, cf->L->is_super ? cf->L->nsuper : (size_t)0);
+}
+
+/* Batch mode: warm-up and --reps timed factorisations per thread count. */
+static void run_batch(const options *o, const matrix_file *m, cholmod_sparse *A) {
     double *samples = malloc(sizeof(double) * (size_t)o->reps);
-    for (int ti = 0; ti < n_threads; ti++) {
-        int threads = o->threads[ti];
-        int controlled = set_threads(threads);
-        if (!controlled && threads > 1) {
-            printf("skipped ordering=%s mode=%s threads=%d reason=blas_threads_not_controllable\n",
-                   used, mode, threads);
-            continue;
+    if (!samples) die("out of memory");
+    for (int oi = 0; oi < o->n_orderings; oi++)
+        for (int mi = 0; mi < o->n_modes; mi++) {
+            config cf;
+            if (!analyse_config(&cf, o, m, A, o->orderings[oi], o->modes[mi])) continue;
+            /* The simplicial factorisation does not call the BLAS: one thread count. */
+            int n_threads = cf.supernodal ? o->n_threads : 1;
+            for (int ti = 0; ti < n_threads; ti++) {
+                int threads = o->threads[ti];
+                if (!set_threads(threads) && threads > 1) {
+                    printf("skipped ordering=%s mode=%s threads=%d "
+                           "reason=blas_threads_not_controllable\n",
+                           cf.ordering, cf.mode, threads);
+                    continue;
+                }
+                double first = factorize_once(&cf, A);
+                if (first < 0.0) {
+                    printf("failed ordering=%s mode=%s stage=factorize status=%d\n", cf.ordering,
+                           cf.mode, cf.c.status);
+                    break;
+                }
+                int r0 = 0;
+                if (first > LONG_RUN_S) samples[r0++] = first;
+                for (int r = r0; r < o->reps; r++) samples[r] = factorize_once(&cf, A);
+                double err = solve_error(A, cf.L, &cf.c);
+                qsort(samples, (size_t)o->reps, sizeof(double), cmp_double);
+                double median = o->reps % 2 ? samples[o->reps / 2]
+                                            : 0.5 * (samples[o->reps / 2 - 1] +
+                                                     samples[o->reps / 2]);
+                print_config(&cf, "result");
+                printf(" threads=%d reps=%d median_s=%.6f min_s=%.6f max_s=%.6f max_err=%.3e\n",
+                       threads, o->reps, median, samples[0], samples[o->reps - 1], err);
+                fflush(stdout);
+            }
+            free_config(&cf);
         }
-        t0 = now_s();
-        int ok = cholmod_l_factorize(A, L, &c);
-        double first = now_s() - t0;
-        if (!ok || c.status != CHOLMOD_OK || L->minor < (size_t)m->n) {
-            printf("failed ordering=%s mode=%s stage=factorize status=%d\n", used, mode, c.status);
-            break;
+    free(samples);
+}
+
+/* Serve mode: analyse every configuration, print one "config id=K ..." line each and
+ * "ready", then answer requests read from stdin, one per line:
+ *   factorize K T   ->  "time id=K threads=T s=..."      (one numeric factorisation)
+ *   check K         ->  "check id=K max_err=..."         (solve with a known solution)
+ *   quit
+ * so that the caller can interleave these factorisations with its own. */
+static void run_serve(const options *o, const matrix_file *m, cholmod_sparse *A) {
+    config *configs = calloc((size_t)(o->n_orderings * o->n_modes), sizeof(config));
+    if (!configs) die("out of memory");
+    int count = 0;
+    for (int oi = 0; oi < o->n_orderings; oi++)
+        for (int mi = 0; mi < o->n_modes; mi++)
+            if (analyse_config(&configs[count], o, m, A, o->orderings[oi], o->modes[mi])) {
+                char prefix[32];
+                snprintf(prefix, sizeof prefix, "config id=%d", count);
+                print_config(&configs[count], prefix);
+                printf("\n");
+                count++;
+            }
+    printf("ready\n");
+    fflush(stdout);
+
+    char line[256];
+    while (fgets(line, sizeof line, stdin)) {
+        int id = -1, threads = 1;
+        if (strncmp(line, "quit", 4) == 0) break;
+        if (sscanf(line, "factorize %d %d", &id, &threads) == 2) {
+            if (id < 0 || id >= count) {
+                printf("error reason=bad_id\n");
+            } else if (!set_threads(threads) && threads > 1) {
+                printf("error reason=blas_threads_not_controllable\n");
+            } else {
+                double t = factorize_once(&configs[id], A);
+                if (t < 0.0)
+                    printf("error reason=factorize_failed status=%d\n", configs[id].c.status);
+                else
+                    printf("time id=%d threads=%d s=%.6f\n", id, threads, t);
+            }
+        } else if (sscanf(line, "check %d", &id) == 1 && id >= 0 && id < count) {
+            printf("check id=%d max_err=%.3e\n", id,
+                   solve_error(A, configs[id].L, &configs[id].c));
+        } else {
+            printf("error reason=bad_request\n");
         }
-        int r0 = 0;
-        if (first > LONG_RUN_S) samples[r0++] = first;
-        for (int r = r0; r < o->reps; r++) {
-            t0 = now_s();
-            cholmod_l_factorize(A, L, &c);
-            samples[r] = now_s() - t0;
-        }
-        double err = solve_error(A, L, &c);
-        double stored = 0.0, sflops = 0.0;
-        if (L->is_super) supernodal_size(L, &stored, &sflops);
-        else {
-            stored = lnz;
-            sflops = fl;
-        }
-        double sum = 0.0;
-        for (int r = 0; r < o->reps; r++) sum += samples[r];
-        qsort(samples, (size_t)o->reps, sizeof(double), cmp_double);
-        double median = o->reps % 2 ? samples[o->reps / 2]
-                                    : 0.5 * (samples[o->reps / 2 - 1] + samples[o->reps / 2]);
-        printf("result ordering=%s mode=%s threads=%d reps=%d median_s=%.6f min_s=%.6f "
-               "max_s=%.6f mean_s=%.6f analyse_s=%.6f lnz=%.0f fl=%.6e stored=%.0f "
-               "stored_flops=%.6e nsuper=%zu is_super=%d max_err=%.3e\n",
-               used, mode, threads, o->reps, median, samples[0], samples[o->reps - 1],
-               sum / o->reps, analyse_s, lnz, fl, stored, sflops, L->is_super ? L->nsuper : 0,
-               L->is_super, err);
         fflush(stdout);
     }
-    free(samples);
-    cholmod_l_free_factor(&L, &c);
-    cholmod_l_finish(&c);
+    for (int k = 0; k < count; k++) free_config(&configs[k]);
+    free(configs);
+}
+
+void dpotrf_(const char *uplo, const int *n, double *a, const int *lda, int *info,
+             size_t uplo_len);
+void dgemm_(const char *transa, const char *transb, const int *m, const int *n, const int *k,
+            const double *alpha, const double *a, const int *lda, const double *b,
+            const int *ldb, const double *beta, double *c, const int *ldc, size_t transa_len,
+            size_t transb_len);
+
+static double median_of(double *v, int count) {
+    qsort(v, (size_t)count, sizeof(double), cmp_double);
+    return count % 2 ? v[count / 2] : 0.5 * (v[count / 2 - 1] + v[count / 2]);
+}
+
+/* Dense SPD matrix, column major: a_ij = ((7 min + 13 max) mod 17)/17 off the diagonal,
+ * a_ii = n. */
+static void fill_dense(double *a, int n) {
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            int lo = i < j ? i : j, hi = i < j ? j : i;
+            a[(size_t)j * n + i] = i == j ? (double)n : (double)((7 * lo + 13 * hi) % 17) / 17.0;
+        }
+}
+
+static void run_dense(const options *o) {
+    int n = o->dense;
+    size_t len = (size_t)n * (size_t)n;
+    double *a = malloc(sizeof(double) * len), *w = malloc(sizeof(double) * len);
+    double *c = malloc(sizeof(double) * len);
+    double *potrf = malloc(sizeof(double) * (size_t)o->reps);
+    double *gemm = malloc(sizeof(double) * (size_t)o->reps);
+    if (!a || !w || !c || !potrf || !gemm) die("out of memory");
+    fill_dense(a, n);
+    printf("info dense=%d blas=\"%s\"\n", n, blas_name());
+    for (int ti = 0; ti < o->n_threads; ti++) {
+        int threads = o->threads[ti];
+        if (!set_threads(threads) && threads > 1) {
+            printf("skipped dense threads=%d reason=blas_threads_not_controllable\n", threads);
+            continue;
+        }
+        int info = 0;
+        for (int r = -1; r < o->reps; r++) {
+            memcpy(w, a, sizeof(double) * len);
+            double t0 = now_s();
+            dpotrf_("L", &n, w, &n, &info, 1);
+            if (r >= 0) potrf[r] = now_s() - t0;
+            if (info != 0) die("dpotrf failed");
+        }
+        double one = 1.0, zero = 0.0;
+        for (int r = -1; r < o->reps; r++) {
+            double t0 = now_s();
+            dgemm_("N", "N", &n, &n, &n, &one, a, &n, w, &n, &zero, c, &n, 1, 1);
+            if (r >= 0) gemm[r] = now_s() - t0;
+        }
+        printf("dense n=%d threads=%d potrf_median_s=%.6f gemm_median_s=%.6f\n", n, threads,
+               median_of(potrf, o->reps), median_of(gemm, o->reps));
+        fflush(stdout);
+    }
+    free(a);
+    free(w);
+    free(c);
+    free(potrf);
+    free(gemm);
 }
 
 int main(int argc, char **argv) {
     options o = parse_options(argc, argv);
+    if (o.dense > 0) {
+        run_dense(&o);
+        return 0;
+    }
     matrix_file m = read_matrix(o.path);
 
     cholmod_common c;
@@ -377,13 +546,15 @@ int main(int argc, char **argv) {
 
     int version[3];
     cholmod_l_version(version);
-    printf("info cholmod=%d.%d.%d n=%lld nnz=%lld blas=\"%s\"\n", version[0], version[1],
-           version[2], (long long)m.n, (long long)m.nnz, blas_name());
+    printf("info cholmod=%d.%d.%d n=%lld nnz=%lld blas_threads=%d blas=\"%s\"\n", version[0],
+           version[1], version[2], (long long)m.n, (long long)m.nnz, set_threads(1),
+           blas_name());
     fflush(stdout);
 
-    for (int oi = 0; oi < o.n_orderings; oi++)
-        for (int mi = 0; mi < o.n_modes; mi++)
-            run_configuration(&o, &m, A, o.orderings[oi], o.modes[mi]);
+    if (o.serve)
+        run_serve(&o, &m, A);
+    else
+        run_batch(&o, &m, A);
 
     cholmod_l_free_sparse(&A, &c);
     cholmod_l_finish(&c);

@@ -57,16 +57,19 @@ bench_contact: time per step of a pad pressed on an adhesive, frictional rigid p
 
 Options:
   --sizes 9,31,70        elements per edge of the bottom face; (n+1)² contact nodes
-                         (default 9,17,31,44)
+                         (default 9,17,31,44,54)
   --probe-sizes 54,70    sizes whose unit costs are probed instead of stepped
-                         (default 54,70; empty to skip)
+                         (default 31,44,54,70; empty to skip)
   --probe-points N       contact nodes of the probed K̄⁻¹Hᵀ subset (default 128)
   --layers N             element layers through the height (default 4)
-  --steps N              steps per repetition (default 4)
+  --steps N              steps per repetition (default 3)
+  --ramp-steps N         steps over which the top moves down (default: --steps)
   --reps N               repetitions per size, each from a fresh stepper (default 3)
+  --budget S             start no further repetition of a size after S seconds
+                         (default 300; the first always runs)
   --mode M               dynamic (θ = ξ = ½, default) or quasi-static
   --dt S                 time step [s] (default 1e-4)
-  --press M              downward displacement of the top face over the steps [m]
+  --press M              downward displacement of the top face over the ramp [m]
                          (default 2e-5)
   --timeout S            wall-time limit of one size [s] (default 1800)
   --memory-fraction F    skip a size whose estimated peak memory exceeds this fraction
@@ -84,7 +87,9 @@ struct Config {
     probe_points: usize,
     layers: usize,
     steps: usize,
+    ramp_steps: Option<usize>,
     reps: usize,
+    budget: f64,
     quasi_static: bool,
     dt: f64,
     press: f64,
@@ -103,12 +108,14 @@ fn fail(msg: &str) -> ! {
 
 fn parse_args() -> Config {
     let mut cfg = Config {
-        sizes: vec![9, 17, 31, 44],
-        probe_sizes: vec![54, 70],
+        sizes: vec![9, 17, 31, 44, 54],
+        probe_sizes: vec![31, 44, 54, 70],
         probe_points: 128,
         layers: 4,
-        steps: 4,
+        steps: 3,
+        ramp_steps: None,
         reps: 3,
+        budget: 300.0,
         quasi_static: false,
         dt: 1e-4,
         press: 2e-5,
@@ -158,6 +165,7 @@ fn parse_args() -> Config {
             "--probe-points" => cfg.probe_points = int(&value).max(1),
             "--layers" => cfg.layers = int(&value).max(1),
             "--steps" => cfg.steps = int(&value).max(1),
+            "--ramp-steps" => cfg.ramp_steps = Some(int(&value).max(1)),
             "--reps" => cfg.reps = int(&value).max(1),
             "--mode" => {
                 cfg.quasi_static = match value.as_str() {
@@ -169,6 +177,7 @@ fn parse_args() -> Config {
             "--dt" => cfg.dt = real(&value),
             "--press" => cfg.press = real(&value),
             "--timeout" => cfg.timeout = real(&value),
+            "--budget" => cfg.budget = real(&value),
             "--memory-fraction" => cfg.memory_fraction = real(&value),
             "--results" => cfg.results = Some(PathBuf::from(value)),
             "--single" => cfg.single = Some(int(&value)),
@@ -196,8 +205,12 @@ fn child_args(cfg: &Config, kind: Kind, n: usize) -> Vec<String> {
         cfg.layers.to_string(),
         "--steps".into(),
         cfg.steps.to_string(),
+        "--ramp-steps".into(),
+        ramp_steps(cfg).to_string(),
         "--reps".into(),
         cfg.reps.to_string(),
+        "--budget".into(),
+        format!("{:e}", cfg.budget),
         "--mode".into(),
         mode_name(cfg).into(),
         "--dt".into(),
@@ -211,6 +224,10 @@ fn child_args(cfg: &Config, kind: Kind, n: usize) -> Vec<String> {
     a
 }
 
+fn ramp_steps(cfg: &Config) -> usize {
+    cfg.ramp_steps.unwrap_or(cfg.steps)
+}
+
 fn mode_name(cfg: &Config) -> &'static str {
     if cfg.quasi_static {
         "quasi-static"
@@ -221,7 +238,7 @@ fn mode_name(cfg: &Config) -> &'static str {
 
 /// The benchmark case as a scenario file.
 fn scenario(cfg: &Config, n: usize) -> String {
-    let ramp_end = cfg.steps as f64 * cfg.dt;
+    let ramp_end = ramp_steps(cfg) as f64 * cfg.dt;
     format!(
         r#"
 name = "bench_contact"
@@ -322,8 +339,12 @@ struct Analysis {
     factorise: f64,
     /// One solve with one right-hand side [s] (median).
     solve_one: f64,
+    /// One solve with 64 right-hand sides, per right-hand side [s] (median).
+    solve_block: f64,
     /// K̄⁻¹Hᵀ for all contact nodes and W = H K̄⁻¹Hᵀ [s].
     delassus: f64,
+    /// The same projected from a subset of the contact nodes, as a probe does [s].
+    delassus_projected: f64,
     cutoffs: Vec<Cutoff>,
 }
 
@@ -357,9 +378,11 @@ struct ProbeResult {
     factorise: f64,
     /// One solve with one right-hand side [s] (median).
     solve_one: f64,
+    /// One solve with 64 right-hand sides, per right-hand side [s] (median).
+    solve_block: f64,
     /// Contact nodes of the subset.
     subset: usize,
-    /// K̄⁻¹Hᵀ and W for the subset [s].
+    /// K̄⁻¹Hᵀ and W for the subset [s] (median).
     subset_delassus: f64,
     /// subset_delassus × contact_nodes / subset [s].
     delassus_projected: f64,
@@ -578,7 +601,11 @@ fn run_size(cfg: &Config, n: usize) -> SizeResult {
     let mut setups = Vec::new();
     let mut steps = Vec::new();
     let mut last: Option<Stepper> = None;
+    let started = Instant::now();
     for rep in 0..cfg.reps {
+        if rep > 0 && started.elapsed().as_secs_f64() > cfg.budget {
+            break;
+        }
         // Free the previous stepper before building the next one.
         drop(last.take());
         let clock = Instant::now();
@@ -604,7 +631,7 @@ fn run_size(cfg: &Config, n: usize) -> SizeResult {
         .unwrap_or_else(|e| fail(&format!("analysis: {e}")));
     let analysis = cfg
         .analysis
-        .then(|| analyse_delassus(&stepper, &mut chol, n));
+        .then(|| analyse_delassus(&stepper, &mut chol, n, cfg.probe_points));
     SizeResult {
         divisions: n,
         layers: cfg.layers,
@@ -653,10 +680,10 @@ fn iteration_matrix(stepper: &Stepper, constrained: &[bool]) -> Vec<f64> {
         .map(|(k, m)| c_stiff * k + c_mass * m)
         .collect();
     for j in 0..p.dim() {
-        for q in p.col_ptr[j]..p.col_ptr[j + 1] {
-            let i = p.row_idx[q];
+        let column = p.col_ptr[j]..p.col_ptr[j + 1];
+        for (k, &i) in kbar[column.clone()].iter_mut().zip(&p.row_idx[column]) {
             if i != j && (constrained[i] || constrained[j]) {
-                kbar[q] = 0.0;
+                *k = 0.0;
             }
         }
     }
@@ -688,7 +715,12 @@ fn committed_forces(stepper: &Stepper, points: &[ContactPoint]) -> Vec<[f64; 3]>
 }
 
 /// Rebuilds W at the final state and measures its decay and the unit costs of a solve.
-fn analyse_delassus(stepper: &Stepper, chol: &mut SparseCholesky, n: usize) -> Analysis {
+fn analyse_delassus(
+    stepper: &Stepper,
+    chol: &mut SparseCholesky,
+    n: usize,
+    probe: usize,
+) -> Analysis {
     let problem = &stepper.problem;
     let dofs = stepper.disc.num_dofs();
     let constrained = constrained_dofs(problem, dofs);
@@ -697,22 +729,9 @@ fn analyse_delassus(stepper: &Stepper, chol: &mut SparseCholesky, n: usize) -> A
         chol.factorise(&kbar)
             .unwrap_or_else(|e| fail(&format!("factorisation: {e}")))
     });
-    let rhs: Vec<f64> = (0..dofs)
-        .map(|i| ((i * 7919) % 997) as f64 - 498.0)
-        .collect();
-    let solve_one = time_median(5, || {
-        let mut x = rhs.clone();
-        chol.solve_in_place(&mut x);
-        std::hint::black_box(&x);
-    });
-    let t0 = stepper.state.t;
-    let points = detect(
-        &problem.contacts,
-        &stepper.disc.reference,
-        &stepper.state.u,
-        t0,
-        t0 + stepper.next_dt(),
-    );
+    let (solve_one, solve_block) = solve_costs(chol, dofs);
+    let points = step_points(stepper);
+    let (_, delassus_projected) = subset_delassus(&points, chol, &constrained, probe);
     let clock = Instant::now();
     let mut del = delassus(&points, chol, &constrained);
     let delassus_time = clock.elapsed().as_secs_f64();
@@ -730,9 +749,155 @@ fn analyse_delassus(stepper: &Stepper, chol: &mut SparseCholesky, n: usize) -> A
     Analysis {
         factorise,
         solve_one,
+        solve_block,
         delassus: delassus_time,
+        delassus_projected,
         cutoffs,
     }
+}
+
+/// The contact candidates the next step of the stepper would use.
+fn step_points(stepper: &Stepper) -> Vec<ContactPoint> {
+    let t0 = stepper.state.t;
+    detect(
+        &stepper.problem.contacts,
+        &stepper.disc.reference,
+        &stepper.state.u,
+        t0,
+        t0 + stepper.next_dt(),
+    )
+}
+
+/// Median time of one solve with one right-hand side, and per right-hand side of one solve
+/// with 64 [s], with the current factorisation.
+fn solve_costs(chol: &mut SparseCholesky, dofs: usize) -> (f64, f64) {
+    let column = |c: usize| -> Vec<f64> {
+        (0..dofs)
+            .map(|i| (((i + 31 * c) * 7919) % 997) as f64 - 498.0)
+            .collect()
+    };
+    let one = column(0);
+    let block: Vec<f64> = (0..64).flat_map(column).collect();
+    let solve_one = time_median(5, || {
+        let mut x = one.clone();
+        chol.solve_in_place(&mut x);
+        std::hint::black_box(&x);
+    });
+    let solve_block = time_median(3, || {
+        let mut x = block.clone();
+        chol.solve_in_place(&mut x);
+        std::hint::black_box(&x);
+    }) / 64.0;
+    (solve_one, solve_block)
+}
+
+/// Builds K̄⁻¹Hᵀ and W for the first `probe` contact points (median of two after a warm-up)
+/// and returns the number of points used and the time projected to all the points [s].
+fn subset_delassus(
+    points: &[ContactPoint],
+    chol: &mut SparseCholesky,
+    constrained: &[bool],
+    probe: usize,
+) -> (usize, f64) {
+    let k = points.len().min(probe);
+    let t = time_median(2, || {
+        let del = delassus(&points[..k], chol, constrained);
+        std::hint::black_box(&del.w);
+    });
+    (k, t * points.len() as f64 / k as f64)
+}
+
+/// Unit costs of one size without stepping it: factorisation and solves at the reference
+/// state, K̄⁻¹Hᵀ and W for a subset of the contact nodes, and Gauss-Seidel sweeps over all
+/// contact nodes with a dense W of the full size.
+fn probe_size(cfg: &Config, n: usize) -> ProbeResult {
+    let text = scenario(cfg, n);
+    let problem = adhesim::scenario::parse(&text, Path::new("bench_contact.toml"))
+        .unwrap_or_else(|e| fail(&format!("scenario: {e}")));
+    let problem = Arc::new(problem);
+    let clock = Instant::now();
+    let stepper = Stepper::new(problem.clone()).unwrap_or_else(|e| fail(&format!("setup: {e}")));
+    let setup = clock.elapsed().as_secs_f64();
+    let dofs = stepper.disc.num_dofs();
+    let constrained = constrained_dofs(&problem, dofs);
+    let kbar = iteration_matrix(&stepper, &constrained);
+    let mut chol = SparseCholesky::analyse(&stepper.disc.pattern, 0)
+        .unwrap_or_else(|e| fail(&format!("analysis: {e}")));
+    let factorise = time_median(3, || {
+        chol.factorise(&kbar)
+            .unwrap_or_else(|e| fail(&format!("factorisation: {e}")))
+    });
+    let (solve_one, solve_block) = solve_costs(&mut chol, dofs);
+    let points = step_points(&stepper);
+    eprintln!(
+        "  probe n = {n}: {dofs} DOFs, {} contact nodes, factorise {factorise:.3} s",
+        points.len()
+    );
+    let (subset, delassus_projected) =
+        subset_delassus(&points, &mut chol, &constrained, cfg.probe_points);
+    let subset_delassus = delassus_projected * subset as f64 / points.len() as f64;
+    eprintln!("  probe n = {n}: K̄⁻¹Hᵀ and W for {subset} nodes {subset_delassus:.3} s");
+    let gs_sweep = probe_sweep(&stepper, &points, &mut chol, &constrained);
+    ProbeResult {
+        divisions: n,
+        layers: cfg.layers,
+        dofs,
+        contact_nodes: points.len(),
+        factor_nnz: chol.factor_nnz(),
+        threads: rayon::current_num_threads(),
+        setup,
+        factorise,
+        solve_one,
+        solve_block,
+        subset,
+        subset_delassus,
+        delassus_projected,
+        gs_sweep,
+        peak_rss: peak_rss(),
+    }
+}
+
+/// Median time of one Gauss-Seidel sweep over all `points` with a dense W of the full size:
+/// the diagonal blocks are the true one of the first point (every node of the uniform face
+/// sees nearly the same), the couplings zero (a sweep reads every block all the same), and
+/// every point is pressed into the plane.
+fn probe_sweep(
+    stepper: &Stepper,
+    points: &[ContactPoint],
+    chol: &mut SparseCholesky,
+    constrained: &[bool],
+) -> f64 {
+    let np = points.len();
+    let m = 3 * np;
+    let one = delassus(&points[..1], chol, constrained);
+    let mut w = vec![0.0; m * m];
+    for p in 0..np {
+        for a in 0..3 {
+            for c in 0..3 {
+                w[(3 * p + a) * m + 3 * p + c] = one.w[a * 3 + c];
+            }
+        }
+    }
+    let del = Delassus {
+        z: Vec::new(),
+        w,
+        m,
+    };
+    let laws: Vec<_> = stepper.problem.contacts.iter().map(|c| c.law).collect();
+    let bond0 = vec![BondState::default(); np];
+    let x_free = vec![[0.0, 0.0, -1e-7]; np];
+    let zero = vec![[0.0; 3]; np];
+    let dt = stepper.next_dt();
+    let mut per_sweep = Vec::new();
+    for _ in 0..3 {
+        let clock = Instant::now();
+        // A negative tolerance never settles: exactly `max_sweeps` sweeps.
+        let sol = gauss_seidel(
+            points, &laws, &bond0, dt, &del, &x_free, &zero, &zero, -1.0, 3,
+        );
+        per_sweep.push(clock.elapsed().as_secs_f64() / sol.sweeps as f64);
+    }
+    median(per_sweep)
 }
 
 /// Frobenius norm of the 3×3 block (p, q) of a row-major m × m matrix.
@@ -825,6 +990,8 @@ struct Summary {
     assembly_it: f64,
     /// Per Gauss-Seidel sweep [s].
     gs_sweep: f64,
+    /// Gauss-Seidel sweeps per Newton iteration.
+    sweeps_it: f64,
 }
 
 fn summarise(r: &SizeResult) -> Summary {
@@ -864,6 +1031,7 @@ fn summarise(r: &SizeResult) -> Summary {
                 .map(|x| x.gauss_seidel / x.sweeps as f64)
                 .collect(),
         ),
+        sweeps_it: per_newton(&|x| x.sweeps as f64),
     }
 }
 
@@ -915,44 +1083,93 @@ fn report(cfg: &Config, outcomes: &[Outcome], elapsed: f64) -> String {
         .iter()
         .filter_map(|x| match x {
             Outcome::Done(r) => Some(r.as_ref()),
-            Outcome::Skipped { .. } => None,
+            _ => None,
+        })
+        .collect();
+    let probes: Vec<&ProbeResult> = outcomes
+        .iter()
+        .filter_map(|x| match x {
+            Outcome::Probed(r) => Some(r.as_ref()),
+            _ => None,
         })
         .collect();
     let sums: Vec<Summary> = done.iter().map(|r| summarise(r)).collect();
-    let threads = done.first().map_or(0, |r| r.threads);
+    let threads = done
+        .first()
+        .map(|r| r.threads)
+        .or(probes.first().map(|r| r.threads))
+        .unwrap_or(0);
     let _ = writeln!(o, "## bench_contact results\n");
     let _ = writeln!(
         o,
-        "{} mode, Δt = {:e} s, {} element layers, top pressed {:e} m over {} steps; {} repetitions × {} steps per size; {} thread(s) on {}; total {:.0} s.\n",
-        mode_name(cfg),
+        "{} mode, Δt = {:e} s, pad {} × {} × {} m with {} element layers, top pressed {:e} m \
+         over {} steps; per size up to {} repetitions of {} steps (none started after {:.0} s); \
+         {} thread(s) on {}; load average at the end {}; total {:.0} s.\n",
+        if cfg.quasi_static {
+            "quasi-static"
+        } else {
+            "dynamic (θ = ξ = ½)"
+        },
         cfg.dt,
+        WIDTH,
+        HEIGHT,
+        WIDTH,
         cfg.layers,
         cfg.press,
-        cfg.steps,
+        ramp_steps(cfg),
         cfg.reps,
         cfg.steps,
+        cfg.budget,
         threads,
         cpu_model(),
+        load_average(),
         elapsed
     );
+    report_steps(&mut o, cfg, outcomes, &done, &sums);
+    report_iterations(&mut o, &done, &sums);
+    report_growth(&mut o, &done, &sums);
+    report_structure(&mut o, &done);
+    if !probes.is_empty() {
+        report_probes(&mut o, &probes, &done, &sums);
+    }
+    report_raw(&mut o, &done);
+    o
+}
+
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|| "unknown".into())
+}
+
+fn report_steps(
+    o: &mut String,
+    cfg: &Config,
+    outcomes: &[Outcome],
+    done: &[&SizeResult],
+    sums: &[Summary],
+) {
     let _ = writeln!(o, "### Median time per step\n");
     let _ = writeln!(
         o,
-        "| contact nodes | mesh | DOFs | Newton it. | GS sweeps | assembly | factorisation | Delassus | Gauss-Seidel | other | step | contact share | peak memory |"
+        "| contact nodes | mesh | DOFs | steps | Newton it. | GS sweeps | assembly | \
+         factorisation | Delassus | Gauss-Seidel | other | step | contact share | peak memory |"
     );
     let _ = writeln!(
         o,
-        "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
-    for (r, s) in done.iter().zip(&sums) {
+    for (r, s) in done.iter().zip(sums) {
         let _ = writeln!(
             o,
-            "| {} | {}×{}×{} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} % | {:.2} GB |",
+            "| {} | {}×{}×{} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} % | {:.2} GB |",
             r.contact_nodes,
             r.divisions,
             r.layers,
             r.divisions,
             r.dofs,
+            r.steps.len(),
             s.newton,
             s.sweeps,
             ms(s.assembly),
@@ -966,11 +1183,20 @@ fn report(cfg: &Config, outcomes: &[Outcome], elapsed: f64) -> String {
         );
     }
     for x in outcomes {
-        if let Outcome::Skipped { divisions, reason } = x {
+        if let Outcome::Skipped {
+            kind,
+            divisions,
+            reason,
+        } = x
+        {
             let (dofs, nc) = mesh_counts(cfg, *divisions);
+            let what = match kind {
+                Kind::Step => "stepping",
+                Kind::Probe => "probe",
+            };
             let _ = writeln!(
                 o,
-                "| {nc} | {d}×{}×{d} | {dofs} | {reason} ||||||||||",
+                "| {nc} | {d}×{}×{d} | {dofs} | {what} {reason} |||||||||||",
                 cfg.layers,
                 d = divisions
             );
@@ -979,112 +1205,268 @@ fn report(cfg: &Config, outcomes: &[Outcome], elapsed: f64) -> String {
     let cut: usize = sums.iter().map(|s| s.cutbacks).sum();
     let _ = writeln!(
         o,
-        "\nMedians are taken per column over all steps of all repetitions, so a row need not add up. \
-         \"other\" is the step's wall time outside the four phases (residuals, the update Δu += K̄⁻¹Hᵀ r, \
-         commit). Contact share = (Delassus + Gauss-Seidel) / step wall time. Cut-backs: {cut}.\n"
+        "\nMedians are taken per column over all steps of all repetitions, so a row need not add \
+         up. \"other\" is the step's wall time outside the four phases (residuals, the update \
+         Δu += K̄⁻¹Hᵀ r, commit). Contact share = (Delassus + Gauss-Seidel) / step wall time. \
+         Cut-backs: {cut}.\n"
     );
+}
+
+fn report_iterations(o: &mut String, done: &[&SizeResult], sums: &[Summary]) {
     let _ = writeln!(o, "### Per Newton iteration and per sweep\n");
     let _ = writeln!(
         o,
-        "| contact nodes | nnz(L) | assembly | factorisation + solve | Delassus | Gauss-Seidel | one GS sweep | K̄⁻¹Hᵀ + W (dense) |"
+        "| contact nodes | nnz(L) | assembly | factorisation + solve | Delassus | Gauss-Seidel | \
+         GS sweeps | one GS sweep | K̄⁻¹Hᵀ + W (dense) |"
     );
-    let _ = writeln!(o, "|---:|---:|---:|---:|---:|---:|---:|---:|");
-    for (r, s) in done.iter().zip(&sums) {
+    let _ = writeln!(o, "|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for (r, s) in done.iter().zip(sums) {
         let (z, w) = dense_bytes(r.dofs, r.contact_nodes);
         let _ = writeln!(
             o,
-            "| {} | {:.2e} | {} | {} | {} | {} | {} | {:.2} + {:.2} GB |",
+            "| {} | {:.2e} | {} | {} | {} | {} | {:.0} | {} | {:.2} + {:.2} GB |",
             r.contact_nodes,
             r.factor_nnz as f64,
             ms(s.assembly_it),
             ms(s.factorisation_it),
             ms(s.delassus_it),
             ms(s.gs_it),
+            s.sweeps_it,
             ms(s.gs_sweep),
             gb(z),
             gb(w)
         );
     }
+}
+
+/// (N_c, value) of the stepped sizes.
+fn series(done: &[&SizeResult], sums: &[Summary], f: fn(&Summary) -> f64) -> Vec<(f64, f64)> {
+    done.iter()
+        .zip(sums)
+        .map(|(r, s)| (r.contact_nodes as f64, f(s)))
+        .collect()
+}
+
+const FIT_FROM: f64 = 1000.0;
+
+/// A per-size quantity of the report: its name and how to read it from a summary.
+type Quantity = (&'static str, fn(&Summary) -> f64);
+
+fn report_growth(o: &mut String, done: &[&SizeResult], sums: &[Summary]) {
     let _ = writeln!(o, "\n### Growth with the number of contact nodes N_c\n");
-    let phases: [(&str, fn(&Summary) -> f64); 5] = [
+    let phases: [Quantity; 6] = [
         ("assembly / iteration", |s| s.assembly_it),
         ("factorisation / iteration", |s| s.factorisation_it),
         ("Delassus / iteration", |s| s.delassus_it),
         ("Gauss-Seidel / iteration", |s| s.gs_it),
+        ("GS sweeps / iteration", |s| s.sweeps_it),
         ("one GS sweep", |s| s.gs_sweep),
     ];
-    let fits_from = 1000;
     let _ = writeln!(
         o,
-        "Least-squares exponent p of t ∝ N_c^p, over all sizes and over the sizes with N_c ≥ {fits_from}:\n"
+        "Least-squares exponent p of t ∝ N_c^p over all stepped sizes, over the sizes with \
+         N_c ≥ {FIT_FROM}, and between the two largest:\n"
     );
-    let _ = writeln!(o, "| phase | p (all) | p (N_c ≥ {fits_from}) |");
-    let _ = writeln!(o, "|---|---:|---:|");
+    let _ = writeln!(
+        o,
+        "| quantity | p (all) | p (N_c ≥ {FIT_FROM}) | p (two largest) |"
+    );
+    let _ = writeln!(o, "|---|---:|---:|---:|");
+    let fmt = |x: Option<f64>| x.map_or("–".into(), |v| format!("{v:.2}"));
     for (name, f) in phases {
-        let all: Vec<(f64, f64)> = done
-            .iter()
-            .zip(&sums)
-            .map(|(r, s)| (r.contact_nodes as f64, f(s)))
-            .collect();
-        let large: Vec<(f64, f64)> = all
-            .iter()
-            .copied()
-            .filter(|p| p.0 >= fits_from as f64)
-            .collect();
-        let fmt = |x: Option<f64>| x.map_or("–".into(), |v| format!("{v:.2}"));
+        let all = series(done, sums, f);
+        let large: Vec<(f64, f64)> = all.iter().copied().filter(|p| p.0 >= FIT_FROM).collect();
+        let last = &all[all.len().saturating_sub(2)..];
         let _ = writeln!(
             o,
-            "| {name} | {} | {} |",
+            "| {name} | {} | {} | {} |",
             fmt(loglog_slope(&all)),
-            fmt(loglog_slope(&large))
+            fmt(loglog_slope(&large)),
+            fmt(loglog_slope(last))
         );
     }
+}
+
+fn report_structure(o: &mut String, done: &[&SizeResult]) {
     let analysed: Vec<(&SizeResult, &Analysis)> = done
         .iter()
         .filter_map(|r| r.analysis.as_ref().map(|a| (*r, a)))
         .collect();
-    if !analysed.is_empty() {
-        let _ = writeln!(o, "\n### Structure of W at the final state\n");
+    if analysed.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        o,
+        "\n### Unit costs and structure of W at the final state\n"
+    );
+    let _ = writeln!(
+        o,
+        "With K̄ of the final state (medians): one numeric factorisation, one solve with one \
+         right-hand side, the cost per right-hand side of one solve with 64, and K̄⁻¹Hᵀ + W as \
+         built and as projected from a subset of the contact nodes.\n"
+    );
+    let _ = writeln!(
+        o,
+        "| contact nodes | factorise | one solve | per RHS in 64 | Delassus | projected |"
+    );
+    let _ = writeln!(o, "|---:|---:|---:|---:|---:|---:|");
+    for (r, a) in &analysed {
         let _ = writeln!(
             o,
-            "Unit costs with the final K̄ (medians), and the share of off-diagonal 3×3 blocks with \
-             ‖W_pq‖ ≥ ε √(‖W_pp‖ ‖W_qq‖); radius = farthest kept block in element widths; \
-             error = ‖(W − W_ε) r‖ / ‖W r‖ for the committed contact forces r.\n"
+            "| {} | {} | {} | {} | {} | {} |",
+            r.contact_nodes,
+            ms(a.factorise),
+            ms(a.solve_one),
+            ms(a.solve_block),
+            ms(a.delassus),
+            ms(a.delassus_projected)
         );
-        let _ = writeln!(o, "| contact nodes | factorise | one solve | Delassus | ε | kept | per node | radius | error |");
-        let _ = writeln!(o, "|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
-        for (r, a) in &analysed {
-            for (i, c) in a.cutoffs.iter().enumerate() {
-                let head = if i == 0 {
-                    format!(
-                        "| {} | {} | {} | {} ",
-                        r.contact_nodes,
-                        ms(a.factorise),
-                        ms(a.solve_one),
-                        ms(a.delassus)
-                    )
-                } else {
-                    "| | | | ".to_string()
-                };
-                let _ = writeln!(
-                    o,
-                    "{head}| {:.0e} | {:.1} % | {:.0} | {:.1} | {:.1e} |",
-                    c.eps,
-                    100.0 * c.kept_fraction,
-                    c.kept_per_node,
-                    c.radius_elements,
-                    c.force_error
-                );
-            }
+    }
+    let _ = writeln!(
+        o,
+        "\nDecay of W: share of the off-diagonal 3×3 blocks with ‖W_pq‖ ≥ ε √(‖W_pp‖ ‖W_qq‖), \
+         kept blocks per node, farthest kept block (element widths), and the error \
+         ‖(W − W_ε) r‖ / ‖W r‖ of the truncated operator on the committed contact forces r.\n"
+    );
+    let _ = writeln!(
+        o,
+        "| contact nodes | ε | kept | per node | radius | error |"
+    );
+    let _ = writeln!(o, "|---:|---:|---:|---:|---:|---:|");
+    for (r, a) in &analysed {
+        for (i, c) in a.cutoffs.iter().enumerate() {
+            let head = if i == 0 {
+                r.contact_nodes.to_string()
+            } else {
+                String::new()
+            };
+            let _ = writeln!(
+                o,
+                "| {head} | {:.0e} | {:.1} % | {:.0} | {:.1} | {:.1e} |",
+                c.eps,
+                100.0 * c.kept_fraction,
+                c.kept_per_node,
+                c.radius_elements,
+                c.force_error
+            );
         }
     }
+}
+
+/// y(x) from the least-squares power law through `pts` (the sizes with N_c ≥ FIT_FROM when
+/// there are two, else all).
+fn power_law_at(pts: &[(f64, f64)], x: f64) -> f64 {
+    let large: Vec<(f64, f64)> = pts.iter().copied().filter(|p| p.0 >= FIT_FROM).collect();
+    let use_pts = if large.len() >= 2 {
+        large
+    } else {
+        pts.to_vec()
+    };
+    let Some(p) = loglog_slope(&use_pts) else {
+        return f64::NAN;
+    };
+    let k = use_pts.len() as f64;
+    let mx = use_pts.iter().map(|q| q.0.ln()).sum::<f64>() / k;
+    let my = use_pts.iter().map(|q| q.1.ln()).sum::<f64>() / k;
+    (my + p * (x.ln() - mx)).exp()
+}
+
+fn report_probes(o: &mut String, probes: &[&ProbeResult], done: &[&SizeResult], sums: &[Summary]) {
+    let _ = writeln!(o, "\n### Probed sizes (unit costs)\n");
+    let _ = writeln!(
+        o,
+        "Factorisation and solves at the reference state; K̄⁻¹Hᵀ + W built for a subset of the \
+         contact nodes and projected linearly to all of them (each node costs three solves); one \
+         Gauss-Seidel sweep over all nodes with a dense W of the full size.\n"
+    );
+    let _ = writeln!(
+        o,
+        "| contact nodes | DOFs | nnz(L) | factorise | one solve | per RHS in 64 | subset | \
+         subset time | Delassus / iteration | one GS sweep | K̄⁻¹Hᵀ + W (dense) | probe peak memory |"
+    );
+    let _ = writeln!(
+        o,
+        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for p in probes {
+        let (z, w) = dense_bytes(p.dofs, p.contact_nodes);
+        let _ = writeln!(
+            o,
+            "| {} | {} | {:.2e} | {} | {} | {} | {} | {} | {} | {} | {:.2} + {:.2} GB | {:.2} GB |",
+            p.contact_nodes,
+            p.dofs,
+            p.factor_nnz as f64,
+            ms(p.factorise),
+            ms(p.solve_one),
+            ms(p.solve_block),
+            p.subset,
+            ms(p.subset_delassus),
+            ms(p.delassus_projected),
+            ms(p.gs_sweep),
+            gb(z),
+            gb(w),
+            gb(p.peak_rss)
+        );
+    }
+    // The projection needs a power law of the sweeps, so at least two stepped sizes.
+    let (Some(big), Some(big_sum)) = (done.last(), sums.last()) else {
+        return;
+    };
+    if done.len() < 2 {
+        return;
+    }
+    let sweeps = series(done, sums, |s| s.sweeps_it);
+    let _ = writeln!(o, "\n### Projected time per step at the probed sizes\n");
+    let _ = writeln!(
+        o,
+        "Newton iterations per step as at the largest stepped size ({}); assembly per iteration \
+         scaled from it in proportion to the DOFs; factorisation per iteration = factorise + one \
+         solve; GS sweeps per iteration from the power law of the stepped sizes. Contact share \
+         = (Delassus + GS) / (sum of the four phases).\n",
+        big_sum.newton
+    );
+    let _ = writeln!(
+        o,
+        "| contact nodes | Newton it. | GS sweeps / it. | assembly | factorisation | Delassus | \
+         Gauss-Seidel | step | contact share |"
+    );
+    let _ = writeln!(o, "|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for p in probes {
+        let newton = big_sum.newton;
+        let sweeps_it = power_law_at(&sweeps, p.contact_nodes as f64);
+        let assembly = big_sum.assembly_it * p.dofs as f64 / big.dofs as f64 * (newton + 1.0);
+        let factorisation = (p.factorise + p.solve_one) * newton;
+        let delassus = p.delassus_projected * newton;
+        let gs = p.gs_sweep * sweeps_it * newton;
+        let step = assembly + factorisation + delassus + gs;
+        let _ = writeln!(
+            o,
+            "| {} | {} | {:.0} | {} | {} | {} | {} | {} | {:.0} % |",
+            p.contact_nodes,
+            newton,
+            sweeps_it,
+            ms(assembly),
+            ms(factorisation),
+            ms(delassus),
+            ms(gs),
+            ms(step),
+            100.0 * (delassus + gs) / step
+        );
+    }
+}
+
+fn report_raw(o: &mut String, done: &[&SizeResult]) {
     let _ = writeln!(o, "\n### Raw steps\n");
-    let _ = writeln!(o, "| contact nodes | rep | step | Newton | cut-backs | sweeps | assembly | factorisation | Delassus | Gauss-Seidel | wall |");
+    let _ = writeln!(
+        o,
+        "| contact nodes | rep | step | Newton | cut-backs | sweeps | assembly | factorisation | \
+         Delassus | Gauss-Seidel | wall |"
+    );
     let _ = writeln!(
         o,
         "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
-    for r in &done {
+    for r in done {
         for x in &r.steps {
             let _ = writeln!(
                 o,
@@ -1103,5 +1485,4 @@ fn report(cfg: &Config, outcomes: &[Outcome], elapsed: f64) -> String {
             );
         }
     }
-    o
 }

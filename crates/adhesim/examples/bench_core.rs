@@ -5,8 +5,9 @@
 //! 2. METIS ordering, faer symbolic analysis and faer numeric Cholesky factorisation of
 //!    K̄ = K + M/Δt² on 1 and 2 threads;
 //! 3. optionally, the numeric factorisation of the very same matrix by SuiteSparse CHOLMOD
-//!    (through the driver in bench/cholmod), with its own METIS ordering and with the
-//!    elimination order used by faer;
+//!    (through the driver in bench/cholmod, run as a server so that faer and CHOLMOD
+//!    factorisations alternate), with its own METIS ordering and with the elimination
+//!    order used by faer;
 //! 4. Newton iterations per step of a dynamic compression of a 20³ block.
 //!
 //! Every timing is repeated (after one warm-up run, which is kept as a sample when it
@@ -35,10 +36,11 @@ use std::f64::consts::PI;
 use std::fmt::Write as _;
 use std::hint::black_box;
 use std::io::Write as _;
+use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Child, ChildStdin, ChildStdout, Command, Stdio};
 use std::sync::Arc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// Small-strain shear modulus of the Blatz-Ko material [Pa].
 const SHEAR_MODULUS: f64 = 1e6;
@@ -64,6 +66,11 @@ Options:
   --micro-iters N           element calls per microbenchmark repetition (default 20000)
   --dynamic-size N          mesh of the dynamic case (default 20; 0 skips it)
   --dynamic-steps N         steps of the dynamic case (default 20)
+  --dense N                 diagnostic: dense N×N Cholesky and product, faer vs the
+                            driver's BLAS/LAPACK (default 0 = skipped)
+  --faer-relax              diagnostic: faer numeric factorisation (1 thread) with more
+                            aggressive supernode amalgamation, for sizes ≤ --relax-max-size
+  --relax-max-size N        (default 30)
   --results PATH            also write the report (markdown) to PATH
 ";
 
@@ -81,6 +88,9 @@ struct Config {
     micro_iters: usize,
     dynamic_size: usize,
     dynamic_steps: usize,
+    dense: usize,
+    faer_relax: bool,
+    relax_max_size: usize,
     results: Option<PathBuf>,
 }
 
@@ -89,14 +99,19 @@ fn parse_list(s: &str) -> Vec<usize> {
         .map(|x| {
             x.trim()
                 .parse()
-                .unwrap_or_else(|_| fail(&format!("not a number: {x}")))
+                .unwrap_or_else(|_| usage_error(&format!("not a number: {x}")))
         })
         .collect()
 }
 
-fn fail(msg: &str) -> ! {
+fn usage_error(msg: &str) -> ! {
     eprintln!("bench_core: {msg}\n\n{USAGE}");
     std::process::exit(2)
+}
+
+fn fail(msg: &str) -> ! {
+    eprintln!("bench_core: {msg}");
+    std::process::exit(1)
 }
 
 fn parse_args() -> Config {
@@ -114,6 +129,9 @@ fn parse_args() -> Config {
         micro_iters: 20_000,
         dynamic_size: 20,
         dynamic_steps: 20,
+        dense: 0,
+        faer_relax: false,
+        relax_max_size: 30,
         results: None,
     };
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -124,18 +142,22 @@ fn parse_args() -> Config {
             print!("{USAGE}");
             std::process::exit(0);
         }
-        if flag == "--keep-data" {
-            c.keep_data = true;
+        if flag == "--keep-data" || flag == "--faer-relax" {
+            c.keep_data |= flag == "--keep-data";
+            c.faer_relax |= flag == "--faer-relax";
             i += 1;
             continue;
         }
+        if !USAGE.contains(&format!("  {flag} ")) {
+            usage_error(&format!("unknown option {flag}"));
+        }
         let value = args
             .get(i + 1)
-            .unwrap_or_else(|| fail(&format!("{flag} needs a value")))
+            .unwrap_or_else(|| usage_error(&format!("{flag} needs a value")))
             .clone();
         let number = |v: &str| -> usize {
             v.parse()
-                .unwrap_or_else(|_| fail(&format!("{flag}: not a number: {v}")))
+                .unwrap_or_else(|_| usage_error(&format!("{flag}: not a number: {v}")))
         };
         match flag {
             "--sizes" => c.sizes = parse_list(&value),
@@ -148,19 +170,21 @@ fn parse_args() -> Config {
             "--simplicial-max-gflop" => {
                 c.simplicial_max_gflop = value
                     .parse()
-                    .unwrap_or_else(|_| fail("--simplicial-max-gflop: not a number"))
+                    .unwrap_or_else(|_| usage_error("--simplicial-max-gflop: not a number"))
             }
             "--data-dir" => c.data_dir = PathBuf::from(value),
             "--micro-iters" => c.micro_iters = number(&value).max(1),
             "--dynamic-size" => c.dynamic_size = number(&value),
             "--dynamic-steps" => c.dynamic_steps = number(&value).max(1),
             "--results" => c.results = Some(PathBuf::from(value)),
-            _ => fail(&format!("unknown option {flag}")),
+            "--dense" => c.dense = number(&value),
+            "--relax-max-size" => c.relax_max_size = number(&value),
+            _ => usage_error(&format!("unknown option {flag}")),
         }
         i += 2;
     }
-    if c.threads.iter().any(|&t| t == 0) {
-        fail("thread counts must be at least 1");
+    if c.threads.contains(&0) {
+        usage_error("thread counts must be at least 1");
     }
     c
 }
@@ -305,6 +329,7 @@ struct SizeResult {
     analyse: Samples,
     stats: FactorStats,
     numeric: Vec<NumericResult>,
+    relax: Vec<RelaxResult>,
     cholmod: Option<CholmodRun>,
 }
 
@@ -352,15 +377,96 @@ fn symbolic_with(
     fwd: &[usize],
     inv: &[usize],
 ) -> SymbolicCholesky<usize> {
+    symbolic_relaxed(sym, fwd, inv, None)
+}
+
+/// faer's symbolic analysis with the given elimination order and, if given, supernode
+/// relaxation thresholds in place of faer's defaults.
+fn symbolic_relaxed(
+    sym: &SymbolicSparseColMat<usize>,
+    fwd: &[usize],
+    inv: &[usize],
+    relax: Option<&[(usize, f64)]>,
+) -> SymbolicCholesky<usize> {
     let n = sym.nrows();
     let perm = PermRef::new_checked(fwd, inv, n);
+    let mut params = CholeskySymbolicParams::default();
+    if let Some(r) = relax {
+        params.supernodal_params =
+            faer::sparse::linalg::SymbolicSupernodalParams { relax: Some(r) };
+    }
     factorize_symbolic_cholesky(
         sym.as_ref(),
         Side::Upper,
         SymmetricOrdering::Custom(perm),
-        CholeskySymbolicParams::default(),
+        params,
     )
     .expect("symbolic factorisation")
+}
+
+/// Supernode relaxation variants (columns, tolerated fraction of zeros), faer's default
+/// first.
+const RELAX_VARIANTS: [(&str, &[(usize, f64)]); 3] = [
+    (
+        "faer default",
+        &[(4, 1.0), (16, 0.8), (48, 0.1), (usize::MAX, 0.05)],
+    ),
+    (
+        "×2 columns",
+        &[(8, 1.0), (32, 0.8), (96, 0.1), (usize::MAX, 0.05)],
+    ),
+    (
+        "×4 columns",
+        &[(16, 1.0), (64, 0.8), (192, 0.1), (usize::MAX, 0.05)],
+    ),
+];
+
+struct RelaxResult {
+    variant: &'static str,
+    stats: FactorStats,
+    factorise: Samples,
+}
+
+/// faer's numeric factorisation on 1 thread, called directly, for each relaxation variant.
+fn bench_relax(
+    sym: &SymbolicSparseColMat<usize>,
+    fwd: &[usize],
+    inv: &[usize],
+    values: &[f64],
+    reps: usize,
+) -> Vec<RelaxResult> {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::linalg::cholesky::llt::factor::LltRegularization;
+    use faer::sparse::SparseColMatRef;
+    RELAX_VARIANTS
+        .iter()
+        .map(|&(variant, relax)| {
+            let symbolic = symbolic_relaxed(sym, fwd, inv, Some(relax));
+            let mut l = vec![0.0; symbolic.len_val()];
+            let mut mem = MemBuffer::new(
+                symbolic.factorize_numeric_llt_scratch::<f64>(faer::Par::Seq, Default::default()),
+            );
+            let a = SparseColMatRef::new(sym.as_ref(), values);
+            let factorise = time_reps(reps, || {
+                symbolic
+                    .factorize_numeric_llt(
+                        &mut l,
+                        a,
+                        Side::Upper,
+                        LltRegularization::default(),
+                        faer::Par::Seq,
+                        MemStack::new(&mut mem),
+                        Default::default(),
+                    )
+                    .expect("SPD");
+            });
+            RelaxResult {
+                variant,
+                stats: factor_stats(&symbolic),
+                factorise,
+            }
+        })
+        .collect()
 }
 
 /// Writes the upper-triangle CSC matrix and an elimination order in the ADHKBAR1 format
@@ -418,44 +524,116 @@ fn parse_driver_line(line: &str) -> Option<(String, BTreeMap<String, String>)> {
     Some((kind, fields))
 }
 
-fn run_cholmod(cfg: &Config, driver: &Path, matrix: &Path, n: usize) -> CholmodRun {
-    let threads: Vec<String> = cfg.threads.iter().map(|t| t.to_string()).collect();
-    let orderings: Vec<&str> = cfg
-        .cholmod_orderings
-        .split(',')
-        .filter(|o| *o != "given" || n <= cfg.given_max_size)
-        .collect();
-    let output = Command::new(driver)
-        .arg(matrix)
-        .args(["--reps", &cfg.reps.to_string()])
-        .args(["--threads", &threads.join(",")])
-        .args(["--orderings", &orderings.join(",")])
-        .args(["--modes", &cfg.cholmod_modes])
-        .args([
-            "--simplicial-max-gflop",
-            &cfg.simplicial_max_gflop.to_string(),
-        ])
-        .output()
-        .unwrap_or_else(|e| fail(&format!("cannot run {}: {e}", driver.display())));
-    if !output.status.success() {
-        eprintln!(
-            "bench_core: CHOLMOD driver failed: {}",
-            String::from_utf8_lossy(&output.stderr)
-        );
-    }
-    let mut run = CholmodRun::default();
-    for line in String::from_utf8_lossy(&output.stdout).lines() {
-        match parse_driver_line(line) {
-            Some((kind, fields)) if kind == "info" => run.info = fields,
-            Some((kind, fields)) if kind == "result" => run.results.push(fields),
-            Some((kind, fields)) if kind == "note" && fields.contains_key("auto_mode") => {
-                run.auto_modes.push(fields)
+/// Pause before every timed factorisation, so that the BLAS threads of the other process
+/// (OpenBLAS workers spin for about 0.1 s after a call) and rayon's workers are asleep.
+const PAUSE: Duration = Duration::from_millis(200);
+
+/// The CHOLMOD driver running in `--serve` mode: it has analysed the matrix once per
+/// configuration and performs single numeric factorisations on request.
+struct Driver {
+    child: Child,
+    input: ChildStdin,
+    output: BufReader<ChildStdout>,
+    configs: Vec<BTreeMap<String, String>>,
+    blas_threads: bool,
+    run: CholmodRun,
+}
+
+impl Driver {
+    fn start(cfg: &Config, driver: &Path, matrix: &Path, n: usize) -> Driver {
+        let orderings: Vec<&str> = cfg
+            .cholmod_orderings
+            .split(',')
+            .filter(|o| *o != "given" || n <= cfg.given_max_size)
+            .collect();
+        let mut child = Command::new(driver)
+            .arg(matrix)
+            .arg("--serve")
+            .args(["--orderings", &orderings.join(",")])
+            .args(["--modes", &cfg.cholmod_modes])
+            .args([
+                "--simplicial-max-gflop",
+                &cfg.simplicial_max_gflop.to_string(),
+            ])
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .spawn()
+            .unwrap_or_else(|e| fail(&format!("cannot run {}: {e}", driver.display())));
+        let input = child.stdin.take().expect("piped stdin");
+        let output = BufReader::new(child.stdout.take().expect("piped stdout"));
+        let mut d = Driver {
+            child,
+            input,
+            output,
+            configs: Vec::new(),
+            blas_threads: false,
+            run: CholmodRun::default(),
+        };
+        loop {
+            let line = d.read_line();
+            if line.trim() == "ready" {
+                break;
             }
-            Some(_) => run.notes.push(line.to_string()),
-            None => {}
+            match parse_driver_line(&line) {
+                Some((kind, fields)) if kind == "info" => {
+                    d.blas_threads = fields.get("blas_threads").map(String::as_str) == Some("1");
+                    d.run.info = fields;
+                }
+                Some((kind, fields)) if kind == "config" => d.configs.push(fields),
+                Some((kind, fields)) if kind == "note" && fields.contains_key("auto_mode") => {
+                    d.run.auto_modes.push(fields)
+                }
+                Some(_) => d.run.notes.push(line.trim().to_string()),
+                None => {}
+            }
+        }
+        d
+    }
+
+    fn read_line(&mut self) -> String {
+        let mut line = String::new();
+        match self.output.read_line(&mut line) {
+            Ok(n) if n > 0 => line,
+            _ => fail("the CHOLMOD driver stopped unexpectedly"),
         }
     }
-    run
+
+    fn request(&mut self, line: &str) -> BTreeMap<String, String> {
+        writeln!(self.input, "{line}")
+            .and_then(|_| self.input.flush())
+            .unwrap_or_else(|e| fail(&format!("cannot talk to the CHOLMOD driver: {e}")));
+        let reply = self.read_line();
+        match parse_driver_line(&reply) {
+            Some((kind, fields)) if kind != "error" => fields,
+            _ => fail(&format!("CHOLMOD driver: {}", reply.trim())),
+        }
+    }
+
+    /// One timed numeric factorisation of configuration `id` [s].
+    fn factorise(&mut self, id: usize, threads: usize) -> f64 {
+        let reply = self.request(&format!("factorize {id} {threads}"));
+        field(&reply, "s").unwrap_or_else(|| fail("CHOLMOD driver: no time in reply"))
+    }
+
+    /// Configurations to time on `threads` threads (simplicial ones on the first thread
+    /// count only: they do not use the BLAS).
+    fn ids_for(&self, threads: usize, first: bool) -> Vec<usize> {
+        if threads > 1 && !self.blas_threads {
+            return Vec::new();
+        }
+        (0..self.configs.len())
+            .filter(|&k| {
+                first || self.configs[k].get("mode").map(String::as_str) == Some("supernodal")
+            })
+            .collect()
+    }
+
+    fn finish(mut self) -> CholmodRun {
+        let _ = writeln!(self.input, "quit");
+        drop(self.input);
+        let _ = self.child.wait();
+        self.run
+    }
 }
 
 /// The element kernels of a full assembly (gather + element response with tangent) without
@@ -552,36 +730,107 @@ fn bench_size(cfg: &Config, n: usize) -> SizeResult {
 
     let mut ones_image = vec![0.0; dim];
     pattern.symmetric_matvec(&kbar, &vec![1.0; dim], &mut ones_image);
+    let mut driver = cfg.cholmod.as_ref().map(|path| {
+        progress("CHOLMOD analysis");
+        let file = cfg.data_dir.join(format!("kbar_{n}.bin"));
+        export_matrix(&file, pattern, &kbar, &elimination_order)
+            .unwrap_or_else(|e| fail(&format!("cannot write {}: {e}", file.display())));
+        let d = Driver::start(cfg, path, &file, n);
+        if !cfg.keep_data {
+            let _ = std::fs::remove_file(&file);
+        }
+        d
+    });
+
     let mut numeric = Vec::new();
-    for &t in &cfg.threads {
-        progress(&format!("faer numeric factorisation, {t} thread(s)"));
-        let result = with_threads(t, || {
+    let mut cholmod_results = Vec::new();
+    for (ti, &t) in cfg.threads.iter().enumerate() {
+        let ids = driver
+            .as_ref()
+            .map_or(Vec::new(), |d| d.ids_for(t, ti == 0));
+        progress(&format!(
+            "numeric factorisation, {t} thread(s): faer{}",
+            if ids.is_empty() {
+                ""
+            } else {
+                " and CHOLMOD, alternating"
+            }
+        ));
+        let (result, samples) = with_threads(t, || {
             let mut chol = SparseCholesky::analyse(pattern, t).expect("analyse");
             assert_eq!(chol.factor_nnz(), stats.stored, "same symbolic structure");
-            let factorise = time_reps(cfg.reps, || chol.factorise(&kbar).expect("SPD"));
+            let mut faer_run = || {
+                std::thread::sleep(PAUSE);
+                let t0 = Instant::now();
+                chol.factorise(&kbar).expect("SPD");
+                t0.elapsed().as_secs_f64()
+            };
+            let mut cholmod_run = |id: usize| {
+                std::thread::sleep(PAUSE);
+                driver.as_mut().expect("driver").factorise(id, t)
+            };
+            // Warm-up runs, kept as samples when long; then one run of each in turn.
+            let keep = |first: f64| {
+                if first > LONG_RUN {
+                    vec![first]
+                } else {
+                    Vec::new()
+                }
+            };
+            let mut faer = keep(faer_run());
+            let mut cholmod: Vec<Vec<f64>> = ids.iter().map(|&id| keep(cholmod_run(id))).collect();
+            while faer.len() < cfg.reps || cholmod.iter().any(|v| v.len() < cfg.reps) {
+                if faer.len() < cfg.reps {
+                    faer.push(faer_run());
+                }
+                for (k, &id) in ids.iter().enumerate() {
+                    if cholmod[k].len() < cfg.reps {
+                        cholmod[k].push(cholmod_run(id));
+                    }
+                }
+            }
             let mut x = ones_image.clone();
             chol.solve_in_place(&mut x);
             let solve_error = x.iter().map(|v| (v - 1.0).abs()).fold(0.0, f64::max);
-            NumericResult {
-                threads: t,
-                factorise,
-                solve_error,
-            }
+            (
+                NumericResult {
+                    threads: t,
+                    factorise: Samples(faer),
+                    solve_error,
+                },
+                cholmod,
+            )
         });
         numeric.push(result);
-    }
-
-    let cholmod = cfg.cholmod.as_ref().map(|driver| {
-        progress("CHOLMOD");
-        let path = cfg.data_dir.join(format!("kbar_{n}.bin"));
-        export_matrix(&path, pattern, &kbar, &elimination_order)
-            .unwrap_or_else(|e| fail(&format!("cannot write {}: {e}", path.display())));
-        let run = run_cholmod(cfg, driver, &path, n);
-        if !cfg.keep_data {
-            let _ = std::fs::remove_file(&path);
+        if let Some(d) = driver.as_mut() {
+            for (&id, v) in ids.iter().zip(samples) {
+                let v = Samples(v);
+                let check = d.request(&format!("check {id}"));
+                let mut r = d.configs[id].clone();
+                r.insert("threads".into(), t.to_string());
+                r.insert("median_s".into(), format!("{:.6}", v.median()));
+                r.insert("min_s".into(), format!("{:.6}", v.min()));
+                r.insert("max_s".into(), format!("{:.6}", v.max()));
+                r.insert(
+                    "max_err".into(),
+                    check.get("max_err").cloned().unwrap_or_default(),
+                );
+                cholmod_results.push(r);
+            }
         }
+    }
+    let cholmod = driver.map(|d| {
+        let mut run = d.finish();
+        run.results = cholmod_results;
         run
     });
+
+    let relax = if cfg.faer_relax && n <= cfg.relax_max_size {
+        progress("faer supernode relaxation variants, 1 thread");
+        with_threads(1, || bench_relax(&sym, &fwd, &inv, &kbar, cfg.reps))
+    } else {
+        Vec::new()
+    };
 
     SizeResult {
         n,
@@ -595,8 +844,95 @@ fn bench_size(cfg: &Config, n: usize) -> SizeResult {
         analyse,
         stats,
         numeric,
+        relax,
         cholmod,
     }
+}
+
+/// Dense SPD test matrix shared with the CHOLMOD driver: a_ij = ((7i + 13j) mod 17)/17 for
+/// i ≠ j (symmetrised through min/max), a_ii = n.
+fn dense_spd(n: usize) -> faer::Mat<f64> {
+    faer::Mat::from_fn(n, n, |i, j| {
+        if i == j {
+            n as f64
+        } else {
+            let (a, b) = (i.min(j), i.max(j));
+            ((7 * a + 13 * b) % 17) as f64 / 17.0
+        }
+    })
+}
+
+struct DenseResult {
+    threads: usize,
+    cholesky: Samples,
+    product: Samples,
+}
+
+/// faer's dense Cholesky (the kernel of the large supernodes) and matrix product.
+fn bench_dense(n: usize, threads: usize, reps: usize) -> DenseResult {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::linalg::cholesky::llt::factor::{
+        cholesky_in_place, cholesky_in_place_scratch, LltRegularization,
+    };
+    let par = if threads == 1 {
+        faer::Par::Seq
+    } else {
+        faer::Par::rayon(threads)
+    };
+    with_threads(threads, || {
+        let a = dense_spd(n);
+        let mut work = a.clone();
+        let mut mem = MemBuffer::new(cholesky_in_place_scratch::<f64>(n, par, Default::default()));
+        let mut cholesky = Vec::new();
+        for rep in 0..=reps {
+            work.copy_from(&a);
+            let t0 = Instant::now();
+            cholesky_in_place(
+                work.as_mut(),
+                LltRegularization::default(),
+                par,
+                MemStack::new(&mut mem),
+                Default::default(),
+            )
+            .expect("SPD");
+            if rep > 0 {
+                cholesky.push(t0.elapsed().as_secs_f64());
+            }
+        }
+        let mut c = faer::Mat::<f64>::zeros(n, n);
+        let product = time_reps(reps, || {
+            faer::linalg::matmul::matmul(
+                c.as_mut(),
+                faer::Accum::Replace,
+                a.as_ref(),
+                work.as_ref(),
+                1.0,
+                par,
+            );
+            black_box(&c);
+        });
+        DenseResult {
+            threads,
+            cholesky: Samples(cholesky),
+            product,
+        }
+    })
+}
+
+fn run_driver_dense(cfg: &Config, driver: &Path) -> Vec<BTreeMap<String, String>> {
+    let threads: Vec<String> = cfg.threads.iter().map(|t| t.to_string()).collect();
+    let output = Command::new(driver)
+        .args(["--dense", &cfg.dense.to_string()])
+        .args(["--reps", &cfg.reps.to_string()])
+        .args(["--threads", &threads.join(",")])
+        .output()
+        .unwrap_or_else(|e| fail(&format!("cannot run {}: {e}", driver.display())));
+    String::from_utf8_lossy(&output.stdout)
+        .lines()
+        .filter_map(parse_driver_line)
+        .filter(|(kind, _)| kind == "dense")
+        .map(|(_, f)| f)
+        .collect()
 }
 
 struct MicroResult {
@@ -757,6 +1093,7 @@ fn report(
     load: (&str, &str),
     sizes: &[SizeResult],
     micro: &MicroResult,
+    dense: &(Vec<DenseResult>, Vec<BTreeMap<String, String>>),
     dynamic: Option<&DynamicResult>,
 ) -> String {
     let mut s = String::new();
@@ -875,7 +1212,10 @@ fn report(
         s,
         "faer: `SparseCholesky::factorise` (adhesim's METIS node ordering). CHOLMOD (METIS): \
          its own METIS ordering of the scalar graph. CHOLMOD (same order): the elimination \
-         order faer uses, given to CHOLMOD. Ratio = faer / CHOLMOD (target ≤ 1.3).\n"
+         order faer uses, given to CHOLMOD. Ratio = faer / CHOLMOD (target ≤ 1.3). The faer and \
+         CHOLMOD runs alternate (one of each in turn, {} ms apart) so that both see the same \
+         machine load.\n",
+        PAUSE.as_millis()
     );
     let _ = writeln!(
         s,
@@ -962,6 +1302,69 @@ fn report(
             d.wall / n_steps.max(1) as f64
         );
         let _ = writeln!(s, "\nIterations per step: {:?}", d.iterations);
+    }
+
+    if sizes.iter().any(|r| !r.relax.is_empty()) {
+        let _ = writeln!(
+            s,
+            "\n## faer supernode amalgamation (diagnostic, 1 thread, faer called directly)\n"
+        );
+        let _ = writeln!(
+            s,
+            "| mesh | relaxation | supernodes | L entries | Σc² flops | numeric [s] | GFlop/s |"
+        );
+        let _ = writeln!(s, "|---|---|---:|---:|---:|---:|---:|");
+        for r in sizes {
+            for v in &r.relax {
+                let t = v.factorise.median();
+                let _ = writeln!(
+                    s,
+                    "| {}³ | {} | {} | {:.3e} | {:.3e} | {:.3} | {:.1} |",
+                    r.n,
+                    v.variant,
+                    v.stats.supernodes,
+                    v.stats.stored as f64,
+                    v.stats.flops,
+                    t,
+                    v.stats.flops / t * 1e-9
+                );
+            }
+        }
+    }
+
+    if !dense.0.is_empty() {
+        let n = cfg.dense as f64;
+        let (chol_flops, prod_flops) = (n * n * n / 3.0, 2.0 * n * n * n);
+        let _ = writeln!(
+            s,
+            "\n## Dense kernels (diagnostic): {0}×{0} Cholesky and product, GFlop/s\n",
+            cfg.dense
+        );
+        let _ = writeln!(
+            s,
+            "| threads | faer Cholesky | BLAS dpotrf | faer product | BLAS dgemm |"
+        );
+        let _ = writeln!(s, "|---:|---:|---:|---:|---:|");
+        for d in &dense.0 {
+            let blas = dense
+                .1
+                .iter()
+                .find(|r| r.get("threads").and_then(|t| t.parse().ok()) == Some(d.threads));
+            let rate = |key: &str, flops: f64| {
+                opt(blas.and_then(|r| field(r, key)), |t| {
+                    format!("{:.1}", flops / t * 1e-9)
+                })
+            };
+            let _ = writeln!(
+                s,
+                "| {} | {:.1} | {} | {:.1} | {} |",
+                d.threads,
+                chol_flops / d.cholesky.median() * 1e-9,
+                rate("potrf_median_s", chol_flops),
+                prod_flops / d.product.median() * 1e-9,
+                rate("gemm_median_s", prod_flops),
+            );
+        }
     }
 
     let _ = writeln!(s, "\n## Raw samples [s]\n");
@@ -1052,12 +1455,29 @@ fn main() {
         eprintln!("dynamic case {}³, {} thread(s)", cfg.dynamic_size, threads);
         bench_dynamic(cfg.dynamic_size, cfg.dynamic_steps, threads)
     });
+    let dense = if cfg.dense > 0 {
+        eprintln!("dense kernels {}×{}", cfg.dense, cfg.dense);
+        let faer: Vec<DenseResult> = cfg
+            .threads
+            .iter()
+            .map(|&t| bench_dense(cfg.dense, t, cfg.reps))
+            .collect();
+        let blas = cfg
+            .cholmod
+            .as_ref()
+            .map(|d| run_driver_dense(&cfg, d))
+            .unwrap_or_default();
+        (faer, blas)
+    } else {
+        (Vec::new(), Vec::new())
+    };
     let load_end = load_average();
     let text = report(
         &cfg,
         (&load_start, &load_end),
         &sizes,
         &micro,
+        &dense,
         dynamic.as_ref(),
     );
     print!("{text}");
