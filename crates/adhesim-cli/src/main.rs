@@ -38,6 +38,46 @@ enum Command {
         /// Print nothing but errors.
         #[arg(long, short)]
         quiet: bool,
+        /// Apply the scenario's [variants.NAME] table first (e.g. `coarse`).
+        #[arg(long, value_name = "NAME")]
+        variant: Option<String>,
+        /// Override one key: a dotted path into the scenario (`time.dt=1e-4`,
+        /// `contact.indentor.adhesion.cn=5e9`, `body.wheel.material.g=1e7`) or a parameter name
+        /// (`v_descent=0.2`). Repeatable.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        overrides: Vec<String>,
+    },
+    /// Run a parameter study: the cartesian product of the values given with --set, one case
+    /// per worker at a time, each in its own sub-folder of the output directory; then one
+    /// comparison figure per tracked quantity (one curve per case) in DIR/figures/ and a
+    /// summary table DIR/sweep.csv.
+    ///
+    /// Example: adhesim sweep scenarios/paper/plate-on-cylinder.toml
+    ///   --set v_descent=1.0,0.8,0.6,0.4,0.2 --set contact.plate.friction=0,0.2,0.4,0.6,0.8
+    ///
+    /// Exit codes: 0 every case finished, 1 some case stopped early, 2 invalid input.
+    Sweep {
+        /// Scenario file (TOML).
+        scenario: PathBuf,
+        /// A swept key and its values, comma-separated: KEY=V1,V2,... Repeatable; the cases
+        /// are the cartesian product.
+        #[arg(long = "set", value_name = "KEY=V1,V2,...", required = true)]
+        axes: Vec<String>,
+        /// Fixed overrides common to every case (KEY=VALUE). Repeatable.
+        #[arg(long = "fix", value_name = "KEY=VALUE")]
+        fixed: Vec<String>,
+        /// Apply the scenario's [variants.NAME] table to every case.
+        #[arg(long, value_name = "NAME")]
+        variant: Option<String>,
+        /// Cases run at the same time [default: the number of cores].
+        #[arg(long, short)]
+        jobs: Option<usize>,
+        /// Output directory [default: out/<scenario name>-sweep].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Print nothing but errors.
+        #[arg(long, short)]
+        quiet: bool,
     },
     /// Draw figures (PNG) from a finished run's history.csv into DIR/figures/: one per
     /// tracked quantity (displacements, β, contact and adhesive forces) with one curve per
@@ -51,6 +91,12 @@ enum Command {
     Check {
         /// Scenario file (TOML).
         scenario: PathBuf,
+        /// Apply the scenario's [variants.NAME] table first.
+        #[arg(long, value_name = "NAME")]
+        variant: Option<String>,
+        /// Override one key (KEY=VALUE). Repeatable.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        overrides: Vec<String>,
     },
 }
 
@@ -61,9 +107,30 @@ fn main() -> ExitCode {
             scenario,
             out,
             quiet,
-        } => run(&scenario, out, quiet),
-        Command::Check { scenario } => check(&scenario),
-        Command::Plot { dir } => match adhesim::output::figures::draw_history_figures(&dir) {
+            variant,
+            overrides,
+        } => match load_options(variant, &overrides) {
+            Ok(opts) => run(&scenario, &opts, out, quiet),
+            Err(e) => fail_input(e),
+        },
+        Command::Check {
+            scenario,
+            variant,
+            overrides,
+        } => match load_options(variant, &overrides) {
+            Ok(opts) => check(&scenario, &opts),
+            Err(e) => fail_input(e),
+        },
+        Command::Sweep {
+            scenario,
+            axes,
+            fixed,
+            variant,
+            jobs,
+            out,
+            quiet,
+        } => sweep(&scenario, &axes, &fixed, variant, jobs, out, quiet),
+        Command::Plot { dir } => match adhesim::run::draw_figures(&dir) {
             Ok(files) => {
                 for f in files {
                     println!("{}", f.display());
@@ -80,8 +147,20 @@ fn fail_input(msg: impl std::fmt::Display) -> ExitCode {
     ExitCode::from(2)
 }
 
-fn check(path: &Path) -> ExitCode {
-    let problem = match adhesim::scenario::load(path) {
+/// Load options from the command line's --variant and --set.
+fn load_options(
+    variant: Option<String>,
+    overrides: &[String],
+) -> Result<adhesim::scenario::LoadOptions, String> {
+    let overrides = overrides
+        .iter()
+        .map(|o| adhesim::scenario::Override::parse(o).map_err(|e| format!("--set: {e}")))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(adhesim::scenario::LoadOptions { variant, overrides })
+}
+
+fn check(path: &Path, opts: &adhesim::scenario::LoadOptions) -> ExitCode {
+    let problem = match adhesim::scenario::load_with(path, opts) {
         Ok(p) => p,
         Err(e) => return fail_input(e),
     };
@@ -111,12 +190,23 @@ fn check(path: &Path) -> ExitCode {
     ExitCode::SUCCESS
 }
 
-fn run(path: &Path, out: Option<PathBuf>, quiet: bool) -> ExitCode {
-    let problem = match adhesim::scenario::load(path) {
+fn run(
+    path: &Path,
+    opts: &adhesim::scenario::LoadOptions,
+    out: Option<PathBuf>,
+    quiet: bool,
+) -> ExitCode {
+    let problem = match adhesim::scenario::load_with(path, opts) {
         Ok(p) => p,
         Err(e) => return fail_input(e),
     };
-    let out = out.unwrap_or_else(|| PathBuf::from("out").join(&problem.name));
+    let out = out.unwrap_or_else(|| {
+        let name = match &opts.variant {
+            Some(v) => format!("{}-{v}", problem.name),
+            None => problem.name.clone(),
+        };
+        PathBuf::from("out").join(name)
+    });
     let mut progress: Box<dyn Progress> = if quiet {
         Box::new(adhesim::run::Silent)
     } else if std::io::stderr().is_terminal() {
@@ -247,5 +337,123 @@ impl Progress for Lines {
     }
     fn message(&mut self, text: &str) {
         eprintln!("{text}");
+    }
+}
+
+/// Sweep progress as plain lines.
+struct SweepLines {
+    quiet: bool,
+    start: Instant,
+}
+
+impl adhesim::sweep::SweepProgress for SweepLines {
+    fn started(&self, case: &adhesim::sweep::Case, total: usize) {
+        if !self.quiet {
+            eprintln!(
+                "[{:>6.1} s] case {}/{total} started: {}",
+                self.start.elapsed().as_secs_f64(),
+                case.index + 1,
+                case.label
+            );
+        }
+    }
+    fn finished(
+        &self,
+        case: &adhesim::sweep::Case,
+        total: usize,
+        result: &Result<adhesim::run::RunSummary, String>,
+    ) {
+        let what = match result {
+            Ok(s) => match &s.outcome {
+                Outcome::Finished => format!(
+                    "finished: {} steps, {} cut-backs, {:.1} s",
+                    s.steps, s.cutbacks, s.wall_time
+                ),
+                Outcome::Failed(m) => format!("stopped at t = {:.4e} s: {m}", s.t_reached),
+            },
+            Err(m) => format!("could not run: {m}"),
+        };
+        if !self.quiet || !matches!(result, Ok(s) if s.outcome == Outcome::Finished) {
+            eprintln!(
+                "[{:>6.1} s] case {}/{total} ({}) {what}",
+                self.start.elapsed().as_secs_f64(),
+                case.index + 1,
+                case.label
+            );
+        }
+    }
+}
+
+fn sweep(
+    path: &Path,
+    axes: &[String],
+    fixed: &[String],
+    variant: Option<String>,
+    jobs: Option<usize>,
+    out: Option<PathBuf>,
+    quiet: bool,
+) -> ExitCode {
+    let base = match load_options(variant, fixed) {
+        Ok(o) => o,
+        Err(e) => return fail_input(e.replace("--set", "--fix")),
+    };
+    let axes = match axes
+        .iter()
+        .map(|a| adhesim::sweep::Axis::parse(a))
+        .collect::<Result<Vec<_>, _>>()
+    {
+        Ok(a) => a,
+        Err(e) => return fail_input(format!("--set: {e}")),
+    };
+    let problem = match adhesim::scenario::load_with(path, &base) {
+        Ok(p) => p,
+        Err(e) => return fail_input(e),
+    };
+    let out = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-sweep", problem.name)));
+    let cores = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1);
+    let jobs = jobs.unwrap_or(cores).max(1);
+    let options = adhesim::sweep::SweepOptions {
+        base,
+        jobs,
+        threads_per_case: (cores / jobs).max(1),
+    };
+    let n_cases: usize = axes.iter().map(|a| a.values.len()).product();
+    if !quiet {
+        eprintln!(
+            "sweep of {} → {}: {n_cases} cases, {} at a time",
+            path.display(),
+            out.display(),
+            jobs.min(n_cases.max(1))
+        );
+    }
+    let progress = SweepLines {
+        quiet,
+        start: Instant::now(),
+    };
+    let summary = match adhesim::sweep::run_sweep(path, &axes, &options, &out, &progress) {
+        Ok(s) => s,
+        Err(e) => return fail_input(format!("{}: {e}", path.display())),
+    };
+    let failed = summary
+        .results
+        .iter()
+        .filter(|r| !matches!(r, Ok(s) if s.outcome == Outcome::Finished))
+        .count();
+    if !quiet {
+        eprintln!(
+            "done: {} cases ({failed} stopped early) in {:.1} s; summary {}, {} comparison figures in {}",
+            summary.cases.len(),
+            summary.wall_time,
+            out.join("sweep.csv").display(),
+            summary.figures.len(),
+            out.join("figures").display()
+        );
+    }
+    if failed > 0 {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
     }
 }

@@ -1035,6 +1035,7 @@ fn bench_dynamic(n: usize, steps: usize, threads: usize) -> DynamicResult {
         tracks: vec![],
         output: OutputSettings {
             frame_interval: 0.0,
+            ..Default::default()
         },
     };
     with_threads(threads, || {

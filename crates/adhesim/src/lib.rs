@@ -17,6 +17,7 @@ pub mod output;
 pub mod problem;
 pub mod run;
 pub mod scenario;
+pub mod sweep;
 pub mod time;
 
 /// 3×3 matrix of f64 (deformation gradients, stresses).

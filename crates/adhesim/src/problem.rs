@@ -170,10 +170,26 @@ pub struct Track {
 }
 
 /// Output settings.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Default)]
 pub struct OutputSettings {
     /// Write a VTU frame every this many seconds of simulated time (0 = every step).
     pub frame_interval: f64,
+    /// Draw the history figures (PNG) when the run ends.
+    pub figures: bool,
+    /// Maps of contact fields over a pair's slave surface at given times.
+    pub maps: Vec<MapRequest>,
+}
+
+/// Maps of contact fields over the slave surface of a contact pair, drawn at the first
+/// committed step at or after each requested time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MapRequest {
+    /// Index of the contact pair.
+    pub pair: usize,
+    /// Contact fields to map (`beta`, `rn`, `rn_adh`, `rt`, `rt_adh`, `gap`, `slip`, ...).
+    pub fields: Vec<String>,
+    /// Times [s], increasing.
+    pub times: Vec<f64>,
 }
 
 /// Everything a run needs.

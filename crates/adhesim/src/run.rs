@@ -2,6 +2,8 @@
 //! step to the observers and reports progress. A run that cannot go on stops with a clear
 //! message; everything already written stays valid.
 
+use crate::output::maps::MapObserver;
+use crate::output::plot::PlotError;
 use crate::output::{FrameWriter, HistoryObserver, Observer, StepView};
 use crate::problem::Problem;
 use crate::time::{SetupError, StepReport, Stepper};
@@ -102,6 +104,7 @@ pub fn run(
         FrameWriter::new(out_dir, &problem.name, problem.output.frame_interval).map_err(io_err)?;
     let mut history =
         HistoryObserver::new(&out_dir.join("history.csv"), &problem).map_err(io_err)?;
+    let mut maps = MapObserver::new(out_dir, &problem.output.maps).map_err(io_err)?;
     let mut summary = RunSummary {
         name: problem.name.clone(),
         scenario: scenario.map(Path::to_path_buf),
@@ -132,6 +135,7 @@ pub fn run(
         };
         frames.observe(&view).map_err(io_err)?;
         history.observe(&view).map_err(io_err)?;
+        maps.observe(&view).map_err(io_err)?;
     }
     while !stepper.finished() {
         match stepper.step() {
@@ -148,6 +152,7 @@ pub fn run(
                 };
                 frames.observe(&view).map_err(io_err)?;
                 history.observe(&view).map_err(io_err)?;
+                maps.observe(&view).map_err(io_err)?;
                 progress.step(&report, problem.time.t_end);
             }
             Err(e) => {
@@ -157,10 +162,25 @@ pub fn run(
             }
         }
     }
+    if problem.output.figures {
+        // Figures are a convenience drawn from the files just written: a failure to draw
+        // them is reported, and does not change how the run ended.
+        if let Err(e) = draw_figures(out_dir) {
+            progress.message(&format!("figures not drawn: {e}"));
+        }
+    }
     summary.t_reached = stepper.state.t;
     summary.frames = frames.frames();
     summary.wall_time = start.elapsed().as_secs_f64();
     let json = serde_json::to_vec_pretty(&summary).expect("summary serialises");
     crate::output::atomic::write_atomic(&out_dir.join("run.json"), &json).map_err(io_err)?;
     Ok(summary)
+}
+
+/// Draws every figure of a finished (or stopped) run in `dir` into `dir/figures/`: the
+/// history figures and the contact maps. Returns the files written.
+pub fn draw_figures(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+    let mut files = crate::output::figures::draw_history_figures(dir)?;
+    files.extend(crate::output::maps::draw_map_figures(dir)?);
+    Ok(files)
 }

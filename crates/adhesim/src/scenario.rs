@@ -11,7 +11,8 @@ use crate::material::{self, Hyperelastic};
 use crate::mesh::generate::{self, FlatSide};
 use crate::mesh::{Face, Mesh};
 use crate::problem::{
-    Body, Dirichlet, NodalLoad, OutputSettings, Problem, Rotation, Table, TimeSettings, Track,
+    Body, Dirichlet, MapRequest, NodalLoad, OutputSettings, Problem, Rotation, Table, TimeSettings,
+    Track,
 };
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -51,6 +52,16 @@ struct FileScenario {
     tracks: Vec<FileTrack>,
     #[serde(default)]
     output: Option<FileOutput>,
+    #[serde(default, rename = "map")]
+    maps: Vec<FileMap>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileMap {
+    contact: String,
+    fields: Vec<String>,
+    times: Vec<f64>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -232,6 +243,7 @@ struct FileTrack {
 #[serde(deny_unknown_fields)]
 struct FileOutput {
     frame_interval: Option<f64>,
+    figures: Option<bool>,
 }
 
 // ---------------------------------------------------------------------------------------
@@ -279,25 +291,79 @@ impl Ctx<'_> {
     }
 }
 
+pub mod prepare;
+
+pub use prepare::Override;
+
+/// How a scenario file is to be read: an optional named variant (`[variants.NAME]`) and
+/// overrides of single keys, applied in that order.
+#[derive(Clone, Debug, Default)]
+pub struct LoadOptions {
+    /// Name of a `[variants.NAME]` table to apply (e.g. `coarse`).
+    pub variant: Option<String>,
+    /// `key=value` overrides (dotted keys, see [`prepare`]).
+    pub overrides: Vec<Override>,
+}
+
 /// Reads and validates a scenario file.
 pub fn load(path: &Path) -> Result<Problem, ScenarioError> {
+    load_with(path, &LoadOptions::default())
+}
+
+/// Reads a scenario file, applies a variant and overrides, and validates it.
+pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Problem, ScenarioError> {
     let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
         file: path.to_path_buf(),
         message: format!("cannot read the scenario file: {e}"),
     })?;
-    parse(&text, path)
+    parse_with(&text, path, options)
 }
 
 /// Parses and validates scenario text; `path` names the file in errors and sets the default
 /// run name.
 pub fn parse(text: &str, path: &Path) -> Result<Problem, ScenarioError> {
+    parse_with(text, path, &LoadOptions::default())
+}
+
+/// [`parse`] with a variant and overrides.
+pub fn parse_with(
+    text: &str,
+    path: &Path,
+    options: &LoadOptions,
+) -> Result<Problem, ScenarioError> {
     let ctx = Ctx { file: path };
-    let raw: FileScenario = toml::from_str(text).map_err(|e| {
-        ctx.err(format!(
-            "{}\n(see docs/scenario.md for the valid keys and types)",
-            e.to_string().trim_end()
-        ))
-    })?;
+    let hint = "(see docs/scenario.md for the valid keys and types)";
+    let mut doc: toml::Table = toml::from_str(text)
+        .map_err(|e| ctx.err(format!("{}\n{hint}", e.to_string().trim_end())))?;
+    let prepared = prepare::prepare(&mut doc, options.variant.as_deref(), &options.overrides)
+        .map_err(|e| ctx.err(e))?;
+    let raw: FileScenario = if prepared.changed {
+        let applied: Vec<String> = options
+            .variant
+            .iter()
+            .map(|v| format!("variant {v}"))
+            .chain(
+                options
+                    .overrides
+                    .iter()
+                    .map(|o| format!("{}={}", o.key, o.value)),
+            )
+            .collect();
+        FileScenario::deserialize(toml::Value::Table(doc)).map_err(|e| {
+            ctx.err(format!(
+                "{}{}\n{hint}",
+                e.to_string().trim_end(),
+                if applied.is_empty() {
+                    " (after evaluating parameters and expressions)".to_string()
+                } else {
+                    format!(" (after applying {})", applied.join(", "))
+                }
+            ))
+        })?
+    } else {
+        toml::from_str(text)
+            .map_err(|e| ctx.err(format!("{}\n{hint}", e.to_string().trim_end())))?
+    };
     validate(raw, &ctx)
 }
 
@@ -527,6 +593,55 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
             )))
         }
     };
+    let mut maps = Vec::new();
+    for (i, m) in raw.maps.iter().enumerate() {
+        let key = format!("map[{i}]");
+        let pair = contacts
+            .iter()
+            .position(|c| c.name == m.contact)
+            .ok_or_else(|| {
+                ctx.err(format!(
+                    "`{key}.contact` = {:?} is not a contact pair of this scenario; pairs are: {}",
+                    m.contact,
+                    contacts
+                        .iter()
+                        .map(|c| c.name.clone())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
+            })?;
+        if m.fields.is_empty() {
+            return Err(ctx.err(format!(
+                "`{key}.fields` is empty; valid fields are: {}",
+                crate::output::maps::MAP_FIELDS.join(", ")
+            )));
+        }
+        for f in &m.fields {
+            if !crate::output::maps::MAP_FIELDS.contains(&f.as_str()) {
+                return Err(ctx.err(format!(
+                    "`{key}.fields` holds {f:?}; valid fields are: {}",
+                    crate::output::maps::MAP_FIELDS.join(", ")
+                )));
+            }
+        }
+        if m.times.is_empty() {
+            return Err(ctx.err(format!(
+                "`{key}.times` is empty; give the times [s] of the maps"
+            )));
+        }
+        for (j, t) in m.times.iter().enumerate() {
+            ctx.finite(&format!("{key}.times[{j}]"), *t)?;
+            if j > 0 && *t <= m.times[j - 1] {
+                return Err(ctx.err(format!("`{key}.times` must increase strictly")));
+            }
+        }
+        maps.push(MapRequest {
+            pair,
+            fields: m.fields.clone(),
+            times: m.times.clone(),
+        });
+    }
+    let figures = raw.output.as_ref().and_then(|o| o.figures).unwrap_or(true);
     Ok(Problem {
         name,
         bodies,
@@ -536,7 +651,11 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
         time,
         contacts,
         tracks,
-        output: OutputSettings { frame_interval },
+        output: OutputSettings {
+            frame_interval,
+            figures,
+            maps,
+        },
     })
 }
 
@@ -849,6 +968,26 @@ fn build_contact(
     let mesh = &bodies[sb].mesh;
     let local_nodes = mesh.node_sets[&c.slave.set].clone();
     let area = tributary_areas(&slave_faces, &mesh.nodes, &local_nodes);
+    let slave_quads = {
+        let index: BTreeMap<usize, usize> = local_nodes
+            .iter()
+            .enumerate()
+            .map(|(i, &n)| (n, i))
+            .collect();
+        slave_faces
+            .iter()
+            .filter_map(|f| {
+                let q = match f {
+                    Face::Quad(n) => *n,
+                    Face::Tri(n) => [n[0], n[1], n[2], n[2]],
+                };
+                let m = q.map(|n| index.get(&n).copied());
+                m.iter()
+                    .all(Option::is_some)
+                    .then(|| m.map(|i| i.unwrap_or(0)))
+            })
+            .collect()
+    };
     let slave_nodes: Vec<usize> = local_nodes.iter().map(|n| n + offsets[sb]).collect();
     let mean_edge = {
         let mut sum = 0.0;
@@ -939,7 +1078,15 @@ fn build_contact(
     let adhesion = match &c.adhesion {
         None => None,
         Some(a) => {
-            let w = ctx.positive(&format!("{key}.adhesion.w"), a.w)?;
+            // w = 0 is allowed: no adhesion energy, β never grows (the dry interface), which
+            // lets a study switch adhesion off with one value.
+            if !(a.w.is_finite() && a.w >= 0.0) {
+                return Err(ctx.err(format!(
+                    "`{key}.adhesion.w` must be a finite number ≥ 0 [J/m²] (0 = no adhesion), got {}",
+                    a.w
+                )));
+            }
+            let w = a.w;
             let cn = ctx.positive(&format!("{key}.adhesion.cn"), a.cn)?;
             if !(a.ct.is_finite() && a.ct >= 0.0) {
                 return Err(ctx.err(format!(
@@ -974,5 +1121,6 @@ fn build_contact(
         master,
         law: InterfaceLaw { mu, adhesion },
         detection_distance,
+        slave_quads,
     })
 }

@@ -657,7 +657,7 @@ impl Stepper {
                 timings.delassus += clock.elapsed().as_secs_f64();
                 let clock = std::time::Instant::now();
                 let sol = gauss_seidel(
-                    &points, &laws, &bond0, dt, &del, &x_free, &r_contact, &r_dry, 1e-10, 500,
+                    &points, &laws, &bond0, dt, &del, &x_free, &r_contact, &r_dry, 1e-10, 5000,
                 );
                 sweeps += sol.sweeps;
                 timings.contact_solve += clock.elapsed().as_secs_f64();

@@ -59,6 +59,7 @@ pub fn one_body(
         tracks: vec![],
         output: OutputSettings {
             frame_interval: 0.0,
+            ..Default::default()
         },
     }
 }

@@ -247,10 +247,12 @@ fn indent(k: usize) -> Indentation {
             // Candidates: initial gap r²/2R < 0.75 d, i.e. r < 1.32 a. The no-penetration
             // check below covers every surface node, candidate or not.
             detection_distance: 0.75 * D,
+            slave_quads: vec![],
         }],
         tracks: vec![],
         output: OutputSettings {
             frame_interval: 0.0,
+            ..Default::default()
         },
     };
     let dofs = 3 * mesh.num_nodes();

@@ -107,6 +107,9 @@ pub struct ContactPair {
     /// Slave nodes farther than this from the master at the start of a step are not
     /// candidates (and lose their bond) [m].
     pub detection_distance: f64,
+    /// Faces of the slave surface as indices into `slave_nodes` (a triangle repeats its
+    /// last node), for maps of contact fields over the surface.
+    pub slave_quads: Vec<[usize; 4]>,
 }
 
 /// Tributary areas of the nodes of a face set: each face's area split equally among its

@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Axis label (quantity and unit) of a history field suffix, or None for fields not plotted.
-fn field_label(field: &str) -> Option<&'static str> {
+pub fn field_label(field: &str) -> Option<&'static str> {
     Some(match field {
         "ux" => "displacement u_x [m]",
         "uy" => "displacement u_y [m]",

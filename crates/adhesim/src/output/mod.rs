@@ -4,6 +4,7 @@
 pub mod atomic;
 pub mod csv;
 pub mod figures;
+pub mod maps;
 pub mod plot;
 pub mod vtk;
 
@@ -292,9 +293,14 @@ pub fn history_columns(problem: &Problem) -> Vec<String> {
         for f in ["ux", "uy", "uz", "vx", "vy", "vz"] {
             c.push(format!("{}.{f}", tr.name));
         }
-        if track_contact(problem, tr.node).is_some() {
+        let pairs = track_contacts(problem, tr.node);
+        for &(p, _) in &pairs {
             for f in CONTACT_TRACK_FIELDS {
-                c.push(format!("{}.{f}", tr.name));
+                if pairs.len() == 1 {
+                    c.push(format!("{}.{f}", tr.name));
+                } else {
+                    c.push(format!("{}.{}.{f}", tr.name, problem.contacts[p].name));
+                }
             }
         }
     }
@@ -306,14 +312,21 @@ const CONTACT_TRACK_FIELDS: [&str; 9] = [
     "beta", "rn", "rn_dry", "rn_adh", "rt", "rt_adh", "gap", "slip", "state",
 ];
 
-/// (pair, index within the pair) of a tracked node that is a slave node.
-fn track_contact(problem: &Problem, node: usize) -> Option<(usize, usize)> {
-    problem.contacts.iter().enumerate().find_map(|(p, c)| {
-        c.slave_nodes
-            .iter()
-            .position(|&n| n == node)
-            .map(|i| (p, i))
-    })
+/// (pair, index within the pair) for every pair of which a tracked node is a slave node.
+/// A node in one pair gets columns `<track>.<field>`; a node in several pairs (a wheel
+/// between two plates) gets `<track>.<pair>.<field>` for each.
+fn track_contacts(problem: &Problem, node: usize) -> Vec<(usize, usize)> {
+    problem
+        .contacts
+        .iter()
+        .enumerate()
+        .filter_map(|(p, c)| {
+            c.slave_nodes
+                .iter()
+                .position(|&n| n == node)
+                .map(|i| (p, i))
+        })
+        .collect()
 }
 
 impl HistoryObserver {
@@ -366,7 +379,7 @@ impl Observer for HistoryObserver {
             let n = tr.node;
             row.extend_from_slice(&view.state.u[3 * n..3 * n + 3]);
             row.extend_from_slice(&view.state.v[3 * n..3 * n + 3]);
-            if let Some((p, i)) = track_contact(view.problem, n) {
+            for (p, i) in track_contacts(view.problem, n) {
                 let c = &view.contact[p][i];
                 row.extend_from_slice(&[
                     c.beta,

@@ -1,0 +1,488 @@
+//! Parameter studies: the cartesian product of overridden values of a scenario, run in
+//! parallel (one case per worker), each case in its own sub-folder, then compared.
+//!
+//! Outputs in the sweep folder:
+//! - `caseNN_<label>/`: a complete run of each case (history, frames, figures, run.json);
+//! - `sweep.csv`: one row per case: its values, how it ended, its cost, and for every tracked
+//!   quantity (`<track>.<field>`, `<pair>.<field>`) the maximum, minimum and final value;
+//! - `figures/<column>.png`: one figure per tracked quantity, one curve per case.
+
+use crate::output::csv::read_history;
+use crate::output::plot::{draw_line_plot, LinePlot, PlotError, Series};
+use crate::run::{Outcome, RunSummary, Silent};
+use crate::scenario::{LoadOptions, Override, ScenarioError};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+/// One swept key and its values.
+#[derive(Clone, Debug)]
+pub struct Axis {
+    /// Dotted key (see [`crate::scenario::prepare`]).
+    pub key: String,
+    /// Values in the order given.
+    pub values: Vec<toml::Value>,
+    /// The values as written (for labels and folder names).
+    pub texts: Vec<String>,
+}
+
+impl Axis {
+    /// Parses `key=v1,v2,...` (commas inside brackets belong to a value).
+    pub fn parse(text: &str) -> Result<Axis, String> {
+        let (key, values) = text.split_once('=').ok_or_else(|| {
+            format!(
+                "`{text}` is not of the form key=v1,v2,... (e.g. contact.top.friction=0,0.2,0.4)"
+            )
+        })?;
+        let key = key.trim();
+        if key.is_empty() {
+            return Err(format!("`{text}` has an empty key"));
+        }
+        let texts = crate::scenario::prepare::split_values(values);
+        if texts.iter().any(|v| v.is_empty()) {
+            return Err(format!("`{text}` has an empty value"));
+        }
+        let values = texts
+            .iter()
+            .map(|v| crate::scenario::prepare::parse_value(v))
+            .collect();
+        Ok(Axis {
+            key: key.to_string(),
+            values,
+            texts,
+        })
+    }
+
+    /// Short name for labels: the last part of the key.
+    fn short(&self) -> &str {
+        self.key.rsplit('.').next().unwrap_or(&self.key)
+    }
+}
+
+/// One case of a sweep.
+#[derive(Clone, Debug)]
+pub struct Case {
+    /// Position in the sweep (0-based).
+    pub index: usize,
+    /// Legend label, e.g. `friction=0.2, v=1`.
+    pub label: String,
+    /// Sub-folder name.
+    pub dir_name: String,
+    /// The overrides that make this case (after the common ones).
+    pub overrides: Vec<Override>,
+    /// The values as written, one per axis.
+    pub texts: Vec<String>,
+}
+
+/// The cartesian product of the axes, the first axis varying slowest.
+pub fn cases(axes: &[Axis]) -> Vec<Case> {
+    let total: usize = axes.iter().map(|a| a.values.len()).product();
+    let width = total.to_string().len().max(2);
+    (0..total)
+        .map(|index| {
+            let mut rest = index;
+            let mut picks = vec![0; axes.len()];
+            for (k, a) in axes.iter().enumerate().rev() {
+                picks[k] = rest % a.values.len();
+                rest /= a.values.len();
+            }
+            let parts: Vec<String> = axes
+                .iter()
+                .zip(&picks)
+                .map(|(a, &p)| format!("{}={}", a.short(), a.texts[p]))
+                .collect();
+            let label = parts.join(", ");
+            let slug: String = parts
+                .join("_")
+                .chars()
+                .map(|c| {
+                    if c.is_ascii_alphanumeric() || "-._=".contains(c) {
+                        c
+                    } else {
+                        '-'
+                    }
+                })
+                .collect();
+            Case {
+                index,
+                label,
+                dir_name: format!("case{:0width$}_{slug}", index + 1),
+                overrides: axes
+                    .iter()
+                    .zip(&picks)
+                    .map(|(a, &p)| Override {
+                        key: a.key.clone(),
+                        value: a.values[p].clone(),
+                    })
+                    .collect(),
+                texts: axes
+                    .iter()
+                    .zip(&picks)
+                    .map(|(a, &p)| a.texts[p].clone())
+                    .collect(),
+            }
+        })
+        .collect()
+}
+
+/// How a sweep is run.
+#[derive(Clone, Debug)]
+pub struct SweepOptions {
+    /// Variant and overrides common to every case.
+    pub base: LoadOptions,
+    /// Cases run at the same time.
+    pub jobs: usize,
+    /// Threads of each case's own pool (element loops, factorisation).
+    pub threads_per_case: usize,
+}
+
+/// Receives sweep progress (the CLI prints lines).
+pub trait SweepProgress: Sync {
+    /// A case starts.
+    fn started(&self, case: &Case, total: usize);
+    /// A case ended (or could not run: `Err`).
+    fn finished(&self, case: &Case, total: usize, result: &Result<RunSummary, String>);
+}
+
+/// Progress that is not shown.
+pub struct QuietSweep;
+impl SweepProgress for QuietSweep {
+    fn started(&self, _: &Case, _: usize) {}
+    fn finished(&self, _: &Case, _: usize, _: &Result<RunSummary, String>) {}
+}
+
+/// Errors that prevent a sweep from running.
+#[derive(Debug, thiserror::Error)]
+pub enum SweepError {
+    /// A case's scenario is invalid (checked for every case before any runs).
+    #[error("case {label}: {source}")]
+    Scenario {
+        /// The case.
+        label: String,
+        /// What is wrong.
+        source: ScenarioError,
+    },
+    /// No axis or an axis without values.
+    #[error("{0}")]
+    Axes(String),
+    /// An output could not be written.
+    #[error("cannot write {path}: {source}")]
+    Io {
+        /// The file or folder.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// A comparison figure could not be drawn.
+    #[error(transparent)]
+    Plot(#[from] PlotError),
+}
+
+/// What a sweep did.
+#[derive(Debug)]
+pub struct SweepSummary {
+    /// The cases, in order.
+    pub cases: Vec<Case>,
+    /// Each case's run summary, or why it could not run.
+    pub results: Vec<Result<RunSummary, String>>,
+    /// Comparison figures written.
+    pub figures: Vec<PathBuf>,
+    /// Wall time of the whole sweep [s].
+    pub wall_time: f64,
+}
+
+/// Runs every case of `axes` on `scenario` into `out_dir`, `options.jobs` at a time.
+/// Every case is validated first, so that a bad value stops the sweep before anything runs.
+pub fn run_sweep(
+    scenario: &Path,
+    axes: &[Axis],
+    options: &SweepOptions,
+    out_dir: &Path,
+    progress: &dyn SweepProgress,
+) -> Result<SweepSummary, SweepError> {
+    let start = std::time::Instant::now();
+    if axes.is_empty() {
+        return Err(SweepError::Axes(
+            "a sweep needs at least one --set key=v1,v2,...".into(),
+        ));
+    }
+    for a in axes {
+        if a.values.is_empty() {
+            return Err(SweepError::Axes(format!("`{}` has no values", a.key)));
+        }
+        if axes.iter().filter(|b| b.key == a.key).count() > 1 {
+            return Err(SweepError::Axes(format!("`{}` is swept twice", a.key)));
+        }
+    }
+    let cases = cases(axes);
+    let case_options = |c: &Case| LoadOptions {
+        variant: options.base.variant.clone(),
+        overrides: options
+            .base
+            .overrides
+            .iter()
+            .chain(&c.overrides)
+            .cloned()
+            .collect(),
+    };
+    for c in &cases {
+        crate::scenario::load_with(scenario, &case_options(c)).map_err(|source| {
+            SweepError::Scenario {
+                label: c.label.clone(),
+                source,
+            }
+        })?;
+    }
+    std::fs::create_dir_all(out_dir).map_err(|source| SweepError::Io {
+        path: out_dir.to_path_buf(),
+        source,
+    })?;
+    let results: Mutex<Vec<Option<Result<RunSummary, String>>>> =
+        Mutex::new(vec![None; cases.len()]);
+    let next = AtomicUsize::new(0);
+    let jobs = options.jobs.clamp(1, cases.len());
+    let total = cases.len();
+    std::thread::scope(|scope| {
+        for _ in 0..jobs {
+            scope.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::SeqCst);
+                let Some(case) = cases.get(i) else { break };
+                progress.started(case, total);
+                let result = run_case(scenario, case, &case_options(case), options, out_dir);
+                progress.finished(case, total, &result);
+                if let Ok(mut r) = results.lock() {
+                    r[i] = Some(result);
+                }
+            });
+        }
+    });
+    let results: Vec<Result<RunSummary, String>> = results
+        .into_inner()
+        .unwrap_or_default()
+        .into_iter()
+        .map(|r| r.unwrap_or_else(|| Err("the case did not run".into())))
+        .collect();
+    write_summary(out_dir, axes, &cases, &results)?;
+    let figures = draw_comparison(out_dir, &cases)?;
+    Ok(SweepSummary {
+        cases,
+        results,
+        figures,
+        wall_time: start.elapsed().as_secs_f64(),
+    })
+}
+
+fn run_case(
+    scenario: &Path,
+    case: &Case,
+    load: &LoadOptions,
+    options: &SweepOptions,
+    out_dir: &Path,
+) -> Result<RunSummary, String> {
+    let problem = crate::scenario::load_with(scenario, load).map_err(|e| e.to_string())?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(options.threads_per_case.max(1))
+        .build()
+        .map_err(|e| format!("cannot start the case's threads: {e}"))?;
+    let dir = out_dir.join(&case.dir_name);
+    pool.install(|| crate::run::run(problem, Some(scenario), &dir, &mut Silent))
+        .map_err(|e| e.to_string())
+}
+
+/// Quotes a CSV field when it holds a comma or a quote.
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// Whether a history column is a tracked quantity (a track's or a pair's field).
+fn is_tracked(column: &str) -> bool {
+    column.contains('.')
+}
+
+fn write_summary(
+    out_dir: &Path,
+    axes: &[Axis],
+    cases: &[Case],
+    results: &[Result<RunSummary, String>],
+) -> Result<(), SweepError> {
+    // Tracked columns: the union over cases, in first-seen order.
+    let histories: Vec<Option<(Vec<String>, Vec<Vec<f64>>)>> = cases
+        .iter()
+        .map(|c| read_history(out_dir.join(&c.dir_name).join("history.csv")).ok())
+        .collect();
+    let mut tracked: Vec<String> = Vec::new();
+    for (cols, _) in histories.iter().flatten() {
+        for c in cols {
+            if is_tracked(c) && !tracked.contains(c) {
+                tracked.push(c.clone());
+            }
+        }
+    }
+    let mut header = vec!["case".to_string(), "dir".to_string()];
+    header.extend(axes.iter().map(|a| a.key.clone()));
+    header.extend(
+        [
+            "status",
+            "t_reached",
+            "steps",
+            "cutbacks",
+            "newton_iterations",
+            "wall_time",
+        ]
+        .map(String::from),
+    );
+    for c in &tracked {
+        for s in ["max", "min", "final"] {
+            header.push(format!("{c}.{s}"));
+        }
+    }
+    let mut text = header
+        .iter()
+        .map(|h| csv_field(h))
+        .collect::<Vec<_>>()
+        .join(",");
+    text.push('\n');
+    for ((case, result), history) in cases.iter().zip(results).zip(&histories) {
+        let mut row = vec![(case.index + 1).to_string(), csv_field(&case.dir_name)];
+        row.extend(case.texts.iter().map(|t| csv_field(t)));
+        match result {
+            Ok(s) => {
+                row.push(match &s.outcome {
+                    Outcome::Finished => "finished".to_string(),
+                    Outcome::Failed(m) => csv_field(&format!("failed: {m}")),
+                });
+                row.push(format!("{:e}", s.t_reached));
+                row.push(s.steps.to_string());
+                row.push(s.cutbacks.to_string());
+                row.push(s.newton_iterations.to_string());
+                row.push(format!("{:.3}", s.wall_time));
+            }
+            Err(m) => {
+                row.push(csv_field(&format!("error: {m}")));
+                row.extend(std::iter::repeat_n(String::new(), 5));
+            }
+        }
+        for c in &tracked {
+            let stats = history.as_ref().and_then(|(cols, rows)| {
+                let k = cols.iter().position(|x| x == c)?;
+                let v: Vec<f64> = rows
+                    .iter()
+                    .map(|r| r[k])
+                    .filter(|x| x.is_finite())
+                    .collect();
+                let last = rows.last().map(|r| r[k])?;
+                Some([
+                    v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                    v.iter().copied().fold(f64::INFINITY, f64::min),
+                    last,
+                ])
+            });
+            match stats {
+                Some(s) => row.extend(s.iter().map(|x| format!("{x:e}"))),
+                None => row.extend(std::iter::repeat_n(String::new(), 3)),
+            }
+        }
+        text.push_str(&row.join(","));
+        text.push('\n');
+    }
+    let path = out_dir.join("sweep.csv");
+    crate::output::atomic::write_atomic(&path, text.as_bytes())
+        .map_err(|source| SweepError::Io { path, source })
+}
+
+/// One figure per tracked quantity with one curve per case.
+pub fn draw_comparison(out_dir: &Path, cases: &[Case]) -> Result<Vec<PathBuf>, SweepError> {
+    let histories: Vec<(String, Option<(Vec<String>, Vec<Vec<f64>>)>)> = cases
+        .iter()
+        .map(|c| {
+            (
+                c.label.clone(),
+                read_history(out_dir.join(&c.dir_name).join("history.csv")).ok(),
+            )
+        })
+        .collect();
+    let mut tracked: Vec<String> = Vec::new();
+    for (_, h) in &histories {
+        if let Some((cols, _)) = h {
+            for c in cols {
+                let plotted = c
+                    .rsplit_once('.')
+                    .is_some_and(|(_, f)| crate::output::figures::field_label(f).is_some());
+                if plotted && !tracked.contains(c) {
+                    tracked.push(c.clone());
+                }
+            }
+        }
+    }
+    let fig_dir = out_dir.join("figures");
+    std::fs::create_dir_all(&fig_dir).map_err(|source| SweepError::Io {
+        path: fig_dir.clone(),
+        source,
+    })?;
+    let mut written = Vec::new();
+    for column in &tracked {
+        let mut series = Vec::new();
+        for (label, h) in &histories {
+            let Some((cols, rows)) = h else { continue };
+            let (Some(t), Some(k)) = (
+                cols.iter().position(|c| c == "t"),
+                cols.iter().position(|c| c == column),
+            ) else {
+                continue;
+            };
+            series.push(Series {
+                label: label.clone(),
+                x: rows.iter().map(|r| r[t]).collect(),
+                y: rows.iter().map(|r| r[k]).collect(),
+            });
+        }
+        let field = column.rsplit_once('.').map(|(_, f)| f).unwrap_or(column);
+        let owner = column.rsplit_once('.').map(|(o, _)| o).unwrap_or("");
+        let y_label = crate::output::figures::field_label(field).unwrap_or(field);
+        let plot = LinePlot {
+            title: format!(
+                "{} at {owner}: one curve per case",
+                y_label.split(" [").next().unwrap_or(field)
+            ),
+            x_label: "time t [s]".into(),
+            y_label: y_label.into(),
+            series,
+        };
+        let file = fig_dir.join(format!("{column}.png"));
+        draw_line_plot(&file, &plot)?;
+        written.push(file);
+    }
+    Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cases_are_the_cartesian_product_first_axis_slowest() {
+        let axes = vec![
+            Axis::parse("contact.top.friction=0,0.2").unwrap(),
+            Axis::parse("v=1.0,0.8,0.6").unwrap(),
+        ];
+        let c = cases(&axes);
+        assert_eq!(c.len(), 6);
+        assert_eq!(c[0].label, "friction=0, v=1.0");
+        assert_eq!(c[1].label, "friction=0, v=0.8");
+        assert_eq!(c[3].label, "friction=0.2, v=1.0");
+        assert_eq!(c[5].dir_name, "case06_friction=0.2_v=0.6");
+        assert_eq!(c[4].overrides[1].value, toml::Value::Float(0.8));
+    }
+
+    #[test]
+    fn axis_values_keep_arrays_whole() {
+        let a = Axis::parse("body.0.mesh.divisions=[4,2,1],[8,4,1]").unwrap();
+        assert_eq!(a.values.len(), 2);
+        assert!(Axis::parse("novalue").is_err());
+        assert!(Axis::parse("k=1,,2").is_err());
+    }
+}
