@@ -451,10 +451,11 @@ fn mesh_counts(cfg: &Config, n: usize) -> (usize, usize) {
     (3 * nodes, (n + 1) * (n + 1))
 }
 
-/// The dense arrays of one Delassus build: K̄⁻¹Hᵀ (DOFs × 3N_c) and W (3N_c × 3N_c) [bytes].
+/// The dense arrays of one Delassus build: one chunk of K̄⁻¹Hᵀ (DOFs × 64 columns) and W
+/// (3N_c × 3N_c) [bytes].
 fn dense_bytes(dofs: usize, contact_nodes: usize) -> (u64, u64) {
     let m = 3 * contact_nodes as u64;
-    (8 * dofs as u64 * m, 8 * m * m)
+    (8 * dofs as u64 * m.min(64), 8 * m * m)
 }
 
 fn gb(bytes: u64) -> f64 {
@@ -733,9 +734,8 @@ fn analyse_delassus(
     let points = step_points(stepper);
     let (_, delassus_projected) = subset_delassus(&points, chol, &constrained, probe);
     let clock = Instant::now();
-    let mut del = delassus(&points, chol, &constrained);
+    let del = delassus(&points, chol, &constrained);
     let delassus_time = clock.elapsed().as_secs_f64();
-    del.z = Vec::new();
     let forces = committed_forces(stepper, &points);
     let element = WIDTH / n as f64;
     let cutoffs = block_decay(
@@ -878,11 +878,7 @@ fn probe_sweep(
             }
         }
     }
-    let del = Delassus {
-        z: Vec::new(),
-        w,
-        m,
-    };
+    let del = Delassus { w, m };
     let laws: Vec<_> = stepper.problem.contacts.iter().map(|c| c.law).collect();
     let bond0 = vec![BondState::default(); np];
     let x_free = vec![[0.0, 0.0, -1e-7]; np];

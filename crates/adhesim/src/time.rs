@@ -10,7 +10,7 @@
 use crate::assembly::{BadElement, Discretisation};
 use crate::contact::detect::{detect, ContactPoint};
 use crate::contact::law::{BondState, ContactState, PointSolution};
-use crate::contact::solve::{delassus, gauss_seidel};
+use crate::contact::solve::{delassus, delassus_columns, gauss_seidel, Delassus};
 use crate::linalg::{LinalgError, SparseCholesky};
 use crate::problem::Problem;
 use std::sync::Arc;
@@ -75,6 +75,8 @@ pub struct StepReport {
     pub contact_sweeps: usize,
     /// Contact candidates of the step.
     pub contact_points: usize,
+    /// Delassus operators built in the step (0 when the last one could be reused).
+    pub delassus_builds: usize,
     /// Wall time of the successful attempt, by phase [s].
     pub timings: PhaseTimes,
 }
@@ -152,6 +154,8 @@ pub struct Stepper {
     pub contact: Vec<Vec<NodeContact>>,
     /// Diagonal of the bounding box of the reference nodes [m].
     model_size: f64,
+    /// The last Delassus operator and what it was built for (see [`delassus_key`]).
+    delassus_cache: Option<(Vec<u64>, Delassus)>,
 }
 
 struct Attempt {
@@ -166,6 +170,7 @@ struct Attempt {
     points: Vec<ContactPoint>,
     solutions: Vec<PointSolution>,
     sweeps: usize,
+    delassus_builds: usize,
     timings: PhaseTimes,
 }
 
@@ -246,6 +251,7 @@ impl Stepper {
             last_internal: 0.0,
             contact: Vec::new(),
             model_size: 0.0,
+            delassus_cache: None,
         };
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for p in &s.disc.reference {
@@ -371,6 +377,7 @@ impl Stepper {
                         external_work: self.external_work,
                         contact_sweeps,
                         contact_points,
+                        delassus_builds: a.delassus_builds,
                         timings,
                     });
                 }
@@ -512,6 +519,9 @@ impl Stepper {
         let mut tmp = vec![0.0; n];
         let mut kbar = vec![0.0; self.disc.pattern.nnz()];
         let mut last_correction_negligible = false;
+        let mut prev_du_norm: Option<f64> = None;
+        let mut delassus_builds = 0usize;
+        let mut delassus_checked_in_step = 0usize;
         for iter in 1..=ts.max_newton {
             let clock = std::time::Instant::now();
             let asm = self.disc.assemble(&u, true);
@@ -609,6 +619,7 @@ impl Stepper {
                     points,
                     solutions,
                     sweeps,
+                    delassus_builds,
                     timings,
                 });
             }
@@ -639,52 +650,107 @@ impl Stepper {
             self.chol
                 .factorise(&kbar)
                 .map_err(|e| format!("{e} (Newton iteration {iter})"))?;
-            let mut du: Vec<f64> = g.iter().map(|x| -x).collect();
+            // Newton correction against the residual with the current contact forces
+            // Hᵀr_prev; the contact solve then corrects it by K̄⁻¹Hᵀ(r − r_prev). At a converged
+            // iterate r = r_prev and G(u) = Hᵀr whatever W was used, so W may be reused from
+            // an earlier iteration or step (it then only slows the convergence).
+            let mut du: Vec<f64> = (0..n).map(|i| contact_force[i] - g[i]).collect();
             self.chol.solve_in_place(&mut du);
             timings.factorisation += clock.elapsed().as_secs_f64();
             if !points.is_empty() {
                 let clock = std::time::Instant::now();
-                // Reduced contact system: x = x(u) + H Δu_free + W r.
-                let del = delassus(&points, &mut self.chol, &self.constrained);
+                let du_norm = norm(&du);
+                let slow = prev_du_norm.is_some_and(|p| du_norm > DELASSUS_REUSE_RATIO * p);
+                prev_du_norm = Some(du_norm);
+                let key = delassus_key(&points, dt);
+                let mut reusable = matches!(&self.delassus_cache, Some((k, _)) if *k == key);
+                // A W from an earlier step, or a slow convergence, is checked before reuse.
+                if reusable && (slow || delassus_checked_in_step == 0) {
+                    delassus_checked_in_step += 1;
+                    // Slow convergence comes from the nonsmooth contact laws as often as from
+                    // a stale W: probe three columns of the current W (the point carrying the
+                    // largest force) and rebuild only when they differ from the cached ones.
+                    // At the first iteration of a step r_contact is still zero and the probe
+                    // is the first point.
+                    let probe = r_contact
+                        .iter()
+                        .enumerate()
+                        .max_by(|a, b| norm(a.1).total_cmp(&norm(b.1)))
+                        .map(|(p, _)| p)
+                        .unwrap_or(0);
+                    let cached = &self.delassus_cache.as_ref().expect("checked").1;
+                    let fresh = delassus_columns(&points, probe, &mut self.chol, &self.constrained);
+                    let m = cached.m;
+                    let (mut diff, mut size) = (0.0f64, 0.0f64);
+                    for c in 0..3 {
+                        for row in 0..m {
+                            let a = fresh[c * m + row];
+                            let b = cached.w[row * m + 3 * probe + c];
+                            diff += (a - b) * (a - b);
+                            size += a * a;
+                        }
+                    }
+                    reusable = diff <= DELASSUS_STALE_TOL * DELASSUS_STALE_TOL * size;
+                }
+                if !reusable {
+                    let del = delassus(&points, &mut self.chol, &self.constrained);
+                    self.delassus_cache = Some((key, del));
+                    delassus_builds += 1;
+                    delassus_checked_in_step += 1;
+                }
+                let del = &self.delassus_cache.as_ref().expect("built above").1;
+                let m = del.m;
+                // Reduced contact system: x = x(u) + H Δu_free + W (r − r_prev).
                 let x_free: Vec<[f64; 3]> = points
                     .iter()
-                    .map(|pt| {
+                    .enumerate()
+                    .map(|(p, pt)| {
                         let x = pt.local_x(&self.disc.reference, &u);
                         let h = pt.apply_h(&du);
-                        [x[0] + h[0], x[1] + h[1], x[2] + h[2]]
+                        let mut xf = [x[0] + h[0], x[1] + h[1], x[2] + h[2]];
+                        for (a, xa) in xf.iter_mut().enumerate() {
+                            let row = &del.w[(3 * p + a) * m..(3 * p + a + 1) * m];
+                            for (q, rq) in r_contact.iter().enumerate() {
+                                *xa -= row[3 * q] * rq[0]
+                                    + row[3 * q + 1] * rq[1]
+                                    + row[3 * q + 2] * rq[2];
+                            }
+                        }
+                        xf
                     })
                     .collect();
                 timings.delassus += clock.elapsed().as_secs_f64();
                 let clock = std::time::Instant::now();
                 let sol = gauss_seidel(
-                    &points, &laws, &bond0, dt, &del, &x_free, &r_contact, &r_dry, 1e-10, 5000,
+                    &points, &laws, &bond0, dt, del, &x_free, &r_contact, &r_dry, 1e-10, 5000,
                 );
                 sweeps += sol.sweeps;
                 timings.contact_solve += clock.elapsed().as_secs_f64();
                 if !sol.converged {
+                    self.delassus_cache = None;
                     return Err(format!("the contact solve did not settle in {} Gauss-Seidel sweeps (Newton iteration {iter})", sol.sweeps));
                 }
-                contact_force.iter_mut().for_each(|v| *v = 0.0);
+                let clock = std::time::Instant::now();
+                let mut new_force = vec![0.0; n];
                 for (p, ps) in sol.points.iter().enumerate() {
                     let r = ps.r();
                     r_contact[p] = r;
                     r_dry[p] = ps.r_dry;
-                    points[p].add_ht(r, &mut contact_force);
-                    let zc = &del.z[3 * p * n..(3 * p + 3) * n];
-                    for c in 0..3 {
-                        if r[c] != 0.0 {
-                            for i in 0..n {
-                                du[i] += zc[c * n + i] * r[c];
-                            }
-                        }
-                    }
+                    points[p].add_ht(r, &mut new_force);
                 }
                 for i in 0..n {
                     if self.constrained[i] {
-                        contact_force[i] = 0.0;
+                        new_force[i] = 0.0;
                     }
                 }
+                let mut dc: Vec<f64> = (0..n).map(|i| new_force[i] - contact_force[i]).collect();
+                self.chol.solve_in_place(&mut dc);
+                for i in 0..n {
+                    du[i] += dc[i];
+                }
+                contact_force = new_force;
                 solutions = sol.points;
+                timings.delassus += clock.elapsed().as_secs_f64();
             }
             for i in 0..n {
                 u[i] += du[i];
@@ -694,11 +760,38 @@ impl Stepper {
             last_correction_negligible =
                 norm(&du) <= ts.newton_tol * increment.max(1e-6 * self.model_size);
         }
+        self.delassus_cache = None;
         Err(format!(
             "Newton did not converge in {} iterations",
             ts.max_newton
         ))
     }
+}
+
+/// A Newton correction larger than this fraction of the previous one means the contact
+/// coupling is converging slowly: W is rebuilt with the current factorisation.
+const DELASSUS_REUSE_RATIO: f64 = 0.5;
+
+/// Relative change of probed columns of W above which the cached W is rebuilt.
+const DELASSUS_STALE_TOL: f64 = 1e-4;
+
+/// What W depends on besides K̄: the contact points (pair, node, frame, master weights) and
+/// Δt (K̄ = ξK + M/(θΔt²) + ...). Compared bit for bit.
+fn delassus_key(points: &[ContactPoint], dt: f64) -> Vec<u64> {
+    let mut key = Vec::with_capacity(points.len() * 12 + 1);
+    key.push(dt.to_bits());
+    for p in points {
+        key.push(p.pair as u64);
+        key.push(p.slave as u64);
+        for row in &p.frame {
+            key.extend(row.iter().map(|x| x.to_bits()));
+        }
+        for &(m, w) in &p.master {
+            key.push(m as u64);
+            key.push(w.to_bits());
+        }
+    }
+    key
 }
 
 fn norm(x: &[f64]) -> f64 {

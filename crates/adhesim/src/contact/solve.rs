@@ -6,18 +6,20 @@ use super::detect::ContactPoint;
 use super::law::{default_rho, solve_point, BondState, InterfaceLaw, PointProblem, PointSolution};
 use crate::linalg::SparseCholesky;
 
-/// The columns K̄⁻¹Hᵀ (column-major, 3 per contact point) and the dense Delassus operator.
+/// The dense Delassus operator W = H K̄⁻¹ Hᵀ of the contact points.
 pub struct Delassus {
-    /// K̄⁻¹Hᵀ, n_dofs × 3N_c, column-major [m/N].
-    pub z: Vec<f64>,
-    /// W = H K̄⁻¹ Hᵀ, 3N_c × 3N_c, row-major [m/N].
+    /// W, 3N_c × 3N_c, row-major [m/N].
     pub w: Vec<f64>,
     /// 3N_c.
     pub m: usize,
 }
 
-/// Builds K̄⁻¹Hᵀ and W with the current factorisation; constrained unknowns get no contact
-/// force.
+/// Right-hand sides solved at a time when building W: the columns K̄⁻¹Hᵀ of one chunk are
+/// reduced to rows of W and dropped, so the memory is that of W plus DOFs × this.
+const DELASSUS_CHUNK: usize = 64;
+
+/// Builds W with the current factorisation, 64 columns of K̄⁻¹Hᵀ at a time; constrained
+/// unknowns get no contact force.
 pub fn delassus(
     points: &[ContactPoint],
     chol: &mut SparseCholesky,
@@ -25,30 +27,36 @@ pub fn delassus(
 ) -> Delassus {
     let n = constrained.len();
     let m = 3 * points.len();
-    let mut z = vec![0.0; n * m];
-    for (p, pt) in points.iter().enumerate() {
-        for c in 0..3 {
-            let col = &mut z[(3 * p + c) * n..(3 * p + c + 1) * n];
+    let mut w = vec![0.0; m * m];
+    let mut z = vec![0.0; n * DELASSUS_CHUNK.min(m.max(1))];
+    let mut start = 0;
+    while start < m {
+        let cols = DELASSUS_CHUNK.min(m - start);
+        let block = &mut z[..n * cols];
+        block.iter_mut().for_each(|v| *v = 0.0);
+        for j in 0..cols {
+            let (p, c) = ((start + j) / 3, (start + j) % 3);
+            let col = &mut block[j * n..(j + 1) * n];
             let mut r = [0.0; 3];
             r[c] = 1.0;
-            pt.add_ht(r, col);
+            points[p].add_ht(r, col);
             for (v, &fixed) in col.iter_mut().zip(constrained) {
                 if fixed {
                     *v = 0.0;
                 }
             }
         }
-    }
-    chol.solve_in_place(&mut z);
-    let mut w = vec![0.0; m * m];
-    for col in 0..m {
-        let zc = &z[col * n..(col + 1) * n];
-        for (p, pt) in points.iter().enumerate() {
-            let h = pt.apply_h(zc);
-            for a in 0..3 {
-                w[(3 * p + a) * m + col] = h[a];
+        chol.solve_in_place(block);
+        for j in 0..cols {
+            let zc = &block[j * n..(j + 1) * n];
+            for (p, pt) in points.iter().enumerate() {
+                let h = pt.apply_h(zc);
+                for a in 0..3 {
+                    w[(3 * p + a) * m + start + j] = h[a];
+                }
             }
         }
+        start += cols;
     }
     // Symmetrise (W is symmetric in exact arithmetic).
     for i in 0..m {
@@ -58,7 +66,41 @@ pub fn delassus(
             w[j * m + i] = s;
         }
     }
-    Delassus { z, w, m }
+    Delassus { w, m }
+}
+
+/// The three columns of W belonging to contact point `probe`, column-major (3 × 3N_c), with
+/// the current factorisation: three solves instead of 3N_c.
+pub fn delassus_columns(
+    points: &[ContactPoint],
+    probe: usize,
+    chol: &mut SparseCholesky,
+    constrained: &[bool],
+) -> Vec<f64> {
+    let n = constrained.len();
+    let m = 3 * points.len();
+    let mut z = vec![0.0; 3 * n];
+    for c in 0..3 {
+        let col = &mut z[c * n..(c + 1) * n];
+        let mut r = [0.0; 3];
+        r[c] = 1.0;
+        points[probe].add_ht(r, col);
+        for (v, &fixed) in col.iter_mut().zip(constrained) {
+            if fixed {
+                *v = 0.0;
+            }
+        }
+    }
+    chol.solve_in_place(&mut z);
+    let mut out = vec![0.0; 3 * m];
+    for c in 0..3 {
+        let zc = &z[c * n..(c + 1) * n];
+        for (p, pt) in points.iter().enumerate() {
+            let h = pt.apply_h(zc);
+            out[c * m + 3 * p..c * m + 3 * p + 3].copy_from_slice(&h);
+        }
+    }
+    out
 }
 
 /// Result of the Gauss-Seidel solve.
