@@ -84,7 +84,10 @@ fn stopped_and_resumed_run_equals_the_uninterrupted_one() {
     let s = go(&full, RunControl::default()).unwrap();
     assert_eq!(s.outcome, Outcome::Finished);
     assert_eq!(s.steps, 50);
-    assert!(!Checkpoint::path(&full).exists(), "no checkpoint unless asked");
+    assert!(
+        !Checkpoint::path(&full).exists(),
+        "no checkpoint unless asked"
+    );
 
     // Stop after step 7 (checkpoints every 4 steps: at 4, then at 7 on the stop).
     let part = fresh_dir("part");
