@@ -167,8 +167,9 @@ fn interrupt_with(signal: &str) {
     let out = work_dir().join(format!("sig{signal}"));
     let mut child = spawn(&out, 0);
     wait_for_rows(&mut child, &out, 6);
-    let sent = Command::new("kill")
-        .args([&format!("-{signal}"), &child.id().to_string()])
+    let sent = Command::new("sh")
+        .arg("-c")
+        .arg(format!("kill -{signal} {}", child.id()))
         .status()
         .unwrap();
     assert!(sent.success());

@@ -210,6 +210,12 @@ pub fn run_with(
             summary.resumed_from = Some(at);
             summary.checkpoint = Some(at);
             wall_before = c.wall_time;
+            // Half-written files of the interrupted process.
+            for d in [out_dir.to_path_buf(), out_dir.join("vtu")] {
+                if d.is_dir() {
+                    crate::output::atomic::remove_stale_temps(&d).map_err(io_err)?;
+                }
+            }
             let frames = FrameWriter::resume(
                 out_dir,
                 &problem.name,
