@@ -156,7 +156,7 @@ fn killed_run_leaves_readable_outputs_and_resumes_to_the_same_end() {
     child.wait().unwrap();
     assert_eq!(status_in_run_json(&out), "running");
     let rows = check_outputs_readable(&out);
-    assert!(rows >= 12 && rows < 51, "{rows} rows");
+    assert!((12..51).contains(&rows), "{rows} rows");
     resume(&out);
     check_outputs_readable(&out);
     assert_same_end(&out);
