@@ -1,5 +1,6 @@
 //! `adhesim`: command-line front end. Parses arguments, shows progress, maps outcomes to
-//! exit codes (0 success, 1 the run stopped early, 2 invalid input or unwritable output).
+//! exit codes (0 success, 1 the run stopped early, 2 invalid input or unwritable output,
+//! 130 interrupted by Ctrl-C or SIGTERM with a checkpoint to resume from).
 
 use adhesim::run::{Outcome, Progress};
 use adhesim::time::StepReport;
@@ -8,6 +9,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// Finite-element dynamics of soft bodies in frictional contact with recoverable adhesion.
@@ -26,15 +29,29 @@ struct Cli {
 enum Command {
     /// Run a scenario and write its outputs.
     ///
+    /// Long runs: a checkpoint (DIR/checkpoint.bin) is written every --checkpoint-every
+    /// steps; Ctrl-C or SIGTERM stops the run after the current step and writes one (a second
+    /// Ctrl-C stops at once); `adhesim run FILE --resume DIR` continues from it and gives the
+    /// outputs of an uninterrupted run. DIR/run.json says `running`, `finished`,
+    /// `interrupted` or `failed`.
+    ///
     /// Exit codes: 0 the run reached its end time, 1 it stopped early (Δt fell below its
-    /// minimum; everything computed until then is kept), 2 the scenario is invalid or the
-    /// outputs cannot be written.
+    /// minimum; everything computed until then is kept), 2 the scenario is invalid, the
+    /// outputs cannot be written or the checkpoint cannot be resumed, 130 interrupted by
+    /// Ctrl-C or SIGTERM (resume with --resume).
     Run {
         /// Scenario file (TOML).
         scenario: PathBuf,
-        /// Output directory [default: out/<scenario name>].
-        #[arg(long)]
+        /// Output directory [default: out/<scenario name>, or DIR with --resume].
+        #[arg(long, conflicts_with = "resume")]
         out: Option<PathBuf>,
+        /// Write a checkpoint every N committed steps (0: only on Ctrl-C/SIGTERM).
+        #[arg(long, value_name = "N", default_value_t = 100)]
+        checkpoint_every: usize,
+        /// Continue the interrupted run whose outputs are in DIR from its last checkpoint
+        /// (the scenario must be unchanged).
+        #[arg(long, value_name = "DIR")]
+        resume: Option<PathBuf>,
         /// Print nothing but errors.
         #[arg(long, short)]
         quiet: bool,
@@ -106,11 +123,13 @@ fn main() -> ExitCode {
         Command::Run {
             scenario,
             out,
+            checkpoint_every,
+            resume,
             quiet,
             variant,
             overrides,
         } => match load_options(variant, &overrides) {
-            Ok(opts) => run(&scenario, &opts, out, quiet),
+            Ok(opts) => run(&scenario, &opts, out, checkpoint_every, resume, quiet),
             Err(e) => fail_input(e),
         },
         Command::Check {
@@ -194,19 +213,27 @@ fn run(
     path: &Path,
     opts: &adhesim::scenario::LoadOptions,
     out: Option<PathBuf>,
+    checkpoint_every: usize,
+    resume: Option<PathBuf>,
     quiet: bool,
 ) -> ExitCode {
     let problem = match adhesim::scenario::load_with(path, opts) {
         Ok(p) => p,
         Err(e) => return fail_input(e),
     };
-    let out = out.unwrap_or_else(|| {
+    let out = resume.clone().or(out).unwrap_or_else(|| {
         let name = match &opts.variant {
             Some(v) => format!("{}-{v}", problem.name),
             None => problem.name.clone(),
         };
         PathBuf::from("out").join(name)
     });
+    let control = adhesim::run::RunControl {
+        checkpoint_every,
+        resume: resume.is_some(),
+        stop: Some(stop_on_signals()),
+        stop_after_steps: None,
+    };
     let mut progress: Box<dyn Progress> = if quiet {
         Box::new(adhesim::run::Silent)
     } else if std::io::stderr().is_terminal() {
@@ -215,12 +242,18 @@ fn run(
         Box::new(Lines::new())
     };
     if !quiet {
-        eprintln!("running {} → {}", path.display(), out.display());
+        let verb = if resume.is_some() {
+            "resuming"
+        } else {
+            "running"
+        };
+        eprintln!("{verb} {} → {}", path.display(), out.display());
     }
-    let summary = match adhesim::run::run(problem, Some(path), &out, progress.as_mut()) {
-        Ok(s) => s,
-        Err(e) => return fail_input(format!("{}: {e}", path.display())),
-    };
+    let summary =
+        match adhesim::run::run_with(problem, Some(path), &out, progress.as_mut(), &control) {
+            Ok(s) => s,
+            Err(e) => return fail_input(format!("{}: {e}", path.display())),
+        };
     drop(progress);
     match &summary.outcome {
         Outcome::Finished => {
@@ -246,7 +279,36 @@ fn run(
             );
             ExitCode::from(1)
         }
+        Outcome::Interrupted | Outcome::Running => {
+            eprintln!(
+                "interrupted at t = {:.6e} s of {} s (step {}); checkpoint written.\nContinue with: adhesim run {} --resume {}",
+                summary.t_reached,
+                summary.t_end,
+                summary.steps,
+                path.display(),
+                out.display()
+            );
+            ExitCode::from(130)
+        }
     }
+}
+
+/// A flag set by the first Ctrl-C (SIGINT) or SIGTERM: the run stops after the current step
+/// and writes a checkpoint. A second signal ends the process at once (exit code 130); every
+/// output file is still complete, since each is written atomically or row by row.
+fn stop_on_signals() -> Arc<AtomicBool> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = stop.clone();
+    let installed = ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+        eprintln!("\nstopping after the current step (press Ctrl-C again to stop at once)");
+    });
+    if let Err(e) = installed {
+        eprintln!("warning: cannot catch Ctrl-C ({e}); an interrupted run resumes from its last periodic checkpoint");
+    }
+    stop
 }
 
 /// A progress bar for terminals.
@@ -370,6 +432,9 @@ impl adhesim::sweep::SweepProgress for SweepLines {
                     s.steps, s.cutbacks, s.wall_time
                 ),
                 Outcome::Failed(m) => format!("stopped at t = {:.4e} s: {m}", s.t_reached),
+                Outcome::Interrupted | Outcome::Running => {
+                    format!("interrupted at t = {:.4e} s", s.t_reached)
+                }
             },
             Err(m) => format!("could not run: {m}"),
         };

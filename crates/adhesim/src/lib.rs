@@ -8,6 +8,7 @@
 //! Units are SI throughout (m, kg, s, N, Pa).
 
 pub mod assembly;
+pub mod checkpoint;
 pub mod contact;
 pub mod element;
 pub mod linalg;

@@ -1,13 +1,22 @@
 //! The run driver: builds the stepper, advances it to the end time, hands every committed
 //! step to the observers and reports progress. A run that cannot go on stops with a clear
 //! message; everything already written stays valid.
+//!
+//! Long runs: [`RunControl`] asks for a checkpoint every N steps, for a stop after the
+//! current step (a flag set by a signal handler, or a step count) and for resuming from the
+//! checkpoint in the output directory. `run.json` is written when the run starts (status
+//! `running`), rewritten at every checkpoint and at the end (`finished`, `interrupted` or
+//! `failed` with its message), each time atomically; a run.json that says `running` after
+//! the process has gone belongs to a run that was killed.
 
+use crate::checkpoint::{fingerprint, Checkpoint, CheckpointError};
 use crate::output::maps::MapObserver;
 use crate::output::plot::PlotError;
 use crate::output::{FrameWriter, HistoryObserver, Observer, StepView};
 use crate::problem::Problem;
 use crate::time::{SetupError, StepReport, Stepper};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -34,6 +43,42 @@ pub enum Outcome {
     Finished,
     /// Stopped on an error; every committed output is intact.
     Failed(String),
+    /// Stopped on request after a committed step, with a checkpoint to resume from.
+    Interrupted,
+    /// Still running: only in the run.json written while the run goes on (one left behind
+    /// by a process that is gone means the run was killed).
+    Running,
+}
+
+/// How a run is driven besides its problem: checkpoints, stopping, resuming.
+#[derive(Clone, Debug, Default)]
+pub struct RunControl {
+    /// Write a checkpoint every this many committed steps (0: only when the run is stopped
+    /// on request).
+    pub checkpoint_every: usize,
+    /// Continue from the checkpoint in the output directory instead of starting at t = 0.
+    pub resume: bool,
+    /// When set (e.g. by a signal handler) the run stops after the current step, writes a
+    /// checkpoint and ends with [`Outcome::Interrupted`].
+    pub stop: Option<Arc<AtomicBool>>,
+    /// Stop the same way once this many steps have been committed (counted from t = 0).
+    pub stop_after_steps: Option<usize>,
+}
+
+impl RunControl {
+    fn stop_requested(&self, steps: usize) -> bool {
+        self.stop.as_ref().is_some_and(|s| s.load(Ordering::SeqCst))
+            || self.stop_after_steps.is_some_and(|n| steps >= n)
+    }
+}
+
+/// Where a checkpoint was taken.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct CheckpointInfo {
+    /// Committed steps.
+    pub step: usize,
+    /// Simulated time [s].
+    pub t: f64,
 }
 
 /// What a run did.
@@ -63,8 +108,13 @@ pub struct RunSummary {
     pub nodes: usize,
     /// Cells of the discretisation.
     pub cells: usize,
-    /// Wall-clock time [s].
+    /// Wall-clock time [s], summed over the sessions of a resumed run (the time spent
+    /// after the last checkpoint of an interrupted session is not counted).
     pub wall_time: f64,
+    /// The step the run was resumed from, when it was.
+    pub resumed_from: Option<CheckpointInfo>,
+    /// The last checkpoint written (or resumed from).
+    pub checkpoint: Option<CheckpointInfo>,
 }
 
 /// Errors that prevent a run from starting or from writing its outputs.
@@ -81,6 +131,9 @@ pub enum RunError {
         /// The I/O error.
         source: std::io::Error,
     },
+    /// A checkpoint could not be written, read or used.
+    #[error(transparent)]
+    Checkpoint(#[from] CheckpointError),
 }
 
 /// Runs `problem`, writing outputs to `out_dir`; returns the summary (also written to
@@ -92,24 +145,42 @@ pub fn run(
     out_dir: &Path,
     progress: &mut dyn Progress,
 ) -> Result<RunSummary, RunError> {
+    run_with(problem, scenario, out_dir, progress, &RunControl::default())
+}
+
+/// [`run`] with checkpoints, stop requests and resuming as `control` asks.
+///
+/// Resuming reads `out_dir/checkpoint.bin`, refuses a checkpoint written for another
+/// problem, cuts history.csv back to the rows up to the checkpoint, keeps the frames up to it
+/// and goes on from there: the outputs end up as those of an uninterrupted run.
+pub fn run_with(
+    problem: Problem,
+    scenario: Option<&Path>,
+    out_dir: &Path,
+    progress: &mut dyn Progress,
+    control: &RunControl,
+) -> Result<RunSummary, RunError> {
     let start = Instant::now();
     let io_err = |source| RunError::Io {
         dir: out_dir.to_path_buf(),
         source,
     };
-    std::fs::create_dir_all(out_dir).map_err(io_err)?;
+    let resume_from = if control.resume {
+        let c = Checkpoint::read(out_dir)?;
+        c.check_matches(&problem, out_dir)?;
+        Some(c)
+    } else {
+        std::fs::create_dir_all(out_dir).map_err(io_err)?;
+        None
+    };
+    let fingerprint = fingerprint(&problem);
     let problem = Arc::new(problem);
     let mut stepper = Stepper::new(problem.clone())?;
-    let mut frames =
-        FrameWriter::new(out_dir, &problem.name, problem.output.frame_interval).map_err(io_err)?;
-    let mut history =
-        HistoryObserver::new(&out_dir.join("history.csv"), &problem).map_err(io_err)?;
-    let mut maps = MapObserver::new(out_dir, &problem.output.maps).map_err(io_err)?;
     let mut summary = RunSummary {
         name: problem.name.clone(),
         scenario: scenario.map(Path::to_path_buf),
         version: env!("CARGO_PKG_VERSION").to_string(),
-        outcome: Outcome::Finished,
+        outcome: Outcome::Running,
         t_reached: 0.0,
         t_end: problem.time.t_end,
         steps: 0,
@@ -119,62 +190,171 @@ pub fn run(
         nodes: stepper.disc.num_nodes,
         cells: stepper.disc.hexes.len() + stepper.disc.tets.len(),
         wall_time: 0.0,
+        resumed_from: None,
+        checkpoint: None,
     };
-    let initial = StepReport {
-        internal: 0.0,
-        kinetic: stepper.kinetic_energy(&stepper.state.v),
-        ..Default::default()
-    };
-    {
-        let view = StepView {
-            problem: &problem,
-            disc: &stepper.disc,
-            state: &stepper.state,
-            report: &initial,
-            contact: &stepper.contact,
-        };
-        frames.observe(&view).map_err(io_err)?;
-        history.observe(&view).map_err(io_err)?;
-        maps.observe(&view).map_err(io_err)?;
-    }
-    while !stepper.finished() {
-        match stepper.step() {
-            Ok(report) => {
-                summary.steps += 1;
-                summary.cutbacks += report.cutbacks;
-                summary.newton_iterations += report.newton_iterations;
-                let view = StepView {
-                    problem: &problem,
-                    disc: &stepper.disc,
-                    state: &stepper.state,
-                    report: &report,
-                    contact: &stepper.contact,
-                };
-                frames.observe(&view).map_err(io_err)?;
-                history.observe(&view).map_err(io_err)?;
-                maps.observe(&view).map_err(io_err)?;
-                progress.step(&report, problem.time.t_end);
+    let mut wall_before = 0.0;
+    let (mut frames, mut history, mut maps) = match resume_from {
+        Some(c) => {
+            let at = CheckpointInfo {
+                step: c.snapshot.step,
+                t: c.snapshot.t,
+            };
+            stepper
+                .restore(c.snapshot)
+                .map_err(|reason| CheckpointError::Mismatch {
+                    path: Checkpoint::path(out_dir),
+                    reason,
+                })?;
+            summary.steps = at.step;
+            summary.cutbacks = c.cutbacks;
+            summary.newton_iterations = c.newton_iterations;
+            summary.resumed_from = Some(at);
+            summary.checkpoint = Some(at);
+            wall_before = c.wall_time;
+            // Half-written files of the interrupted process.
+            for d in [out_dir.to_path_buf(), out_dir.join("vtu")] {
+                if d.is_dir() {
+                    crate::output::atomic::remove_stale_temps(&d).map_err(io_err)?;
+                }
             }
-            Err(e) => {
-                progress.message(&e.to_string());
-                summary.outcome = Outcome::Failed(e.to_string());
-                break;
+            let frames = FrameWriter::resume(
+                out_dir,
+                &problem.name,
+                problem.output.frame_interval,
+                c.frames,
+            )
+            .map_err(io_err)?;
+            let history =
+                HistoryObserver::resume(&out_dir.join("history.csv"), &problem, c.history_rows)
+                    .map_err(io_err)?;
+            let maps = MapObserver::resume(out_dir, &problem.output.maps, at.t).map_err(io_err)?;
+            (frames, history, maps)
+        }
+        None => {
+            let mut frames =
+                FrameWriter::new(out_dir, &problem.name, problem.output.frame_interval)
+                    .map_err(io_err)?;
+            let mut history =
+                HistoryObserver::new(&out_dir.join("history.csv"), &problem).map_err(io_err)?;
+            let mut maps = MapObserver::new(out_dir, &problem.output.maps).map_err(io_err)?;
+            let initial = StepReport {
+                internal: 0.0,
+                kinetic: stepper.kinetic_energy(&stepper.state.v),
+                ..Default::default()
+            };
+            let view = StepView {
+                problem: &problem,
+                disc: &stepper.disc,
+                state: &stepper.state,
+                report: &initial,
+                contact: &stepper.contact,
+            };
+            frames.observe(&view).map_err(io_err)?;
+            history.observe(&view).map_err(io_err)?;
+            maps.observe(&view).map_err(io_err)?;
+            (frames, history, maps)
+        }
+    };
+    let update = |summary: &mut RunSummary, stepper: &Stepper, frames: &FrameWriter| {
+        summary.t_reached = stepper.state.t;
+        summary.frames = frames.frames();
+        summary.wall_time = wall_before + start.elapsed().as_secs_f64();
+    };
+    update(&mut summary, &stepper, &frames);
+    write_summary(out_dir, &summary).map_err(io_err)?;
+    let save = |summary: &mut RunSummary,
+                stepper: &Stepper,
+                frames: &FrameWriter,
+                history: &HistoryObserver|
+     -> Result<(), RunError> {
+        update(summary, stepper, frames);
+        let c = Checkpoint {
+            version: summary.version.clone(),
+            fingerprint,
+            snapshot: stepper.snapshot(),
+            frames: frames.progress(),
+            history_rows: history.rows_written(),
+            cutbacks: summary.cutbacks,
+            newton_iterations: summary.newton_iterations,
+            wall_time: summary.wall_time,
+        };
+        c.write(out_dir)?;
+        summary.checkpoint = Some(CheckpointInfo {
+            step: stepper.state.step,
+            t: stepper.state.t,
+        });
+        write_summary(out_dir, summary).map_err(|source| RunError::Io {
+            dir: out_dir.to_path_buf(),
+            source,
+        })
+    };
+    let result = (|| -> Result<(), RunError> {
+        while !stepper.finished() {
+            if control.stop_requested(stepper.state.step) {
+                summary.outcome = Outcome::Interrupted;
+                if summary.checkpoint.map(|c| c.step) != Some(stepper.state.step) {
+                    save(&mut summary, &stepper, &frames, &history)?;
+                }
+                return Ok(());
+            }
+            match stepper.step() {
+                Ok(report) => {
+                    summary.steps += 1;
+                    summary.cutbacks += report.cutbacks;
+                    summary.newton_iterations += report.newton_iterations;
+                    let view = StepView {
+                        problem: &problem,
+                        disc: &stepper.disc,
+                        state: &stepper.state,
+                        report: &report,
+                        contact: &stepper.contact,
+                    };
+                    frames.observe(&view).map_err(io_err)?;
+                    history.observe(&view).map_err(io_err)?;
+                    maps.observe(&view).map_err(io_err)?;
+                    progress.step(&report, problem.time.t_end);
+                    let every = control.checkpoint_every;
+                    if every > 0 && stepper.state.step % every == 0 && !stepper.finished() {
+                        save(&mut summary, &stepper, &frames, &history)?;
+                        // A resumed run starts without a Delassus operator to reuse; so does
+                        // this one, so that both take the same Newton iterates.
+                        stepper.forget_delassus();
+                    }
+                }
+                Err(e) => {
+                    progress.message(&e.to_string());
+                    summary.outcome = Outcome::Failed(e.to_string());
+                    return Ok(());
+                }
             }
         }
-    }
-    if problem.output.figures {
+        summary.outcome = Outcome::Finished;
+        Ok(())
+    })();
+    if result.is_ok() && problem.output.figures && summary.outcome != Outcome::Interrupted {
         // Figures are a convenience drawn from the files just written: a failure to draw
         // them is reported, and does not change how the run ended.
         if let Err(e) = draw_figures(out_dir) {
             progress.message(&format!("figures not drawn: {e}"));
         }
     }
-    summary.t_reached = stepper.state.t;
-    summary.frames = frames.frames();
-    summary.wall_time = start.elapsed().as_secs_f64();
-    let json = serde_json::to_vec_pretty(&summary).expect("summary serialises");
-    crate::output::atomic::write_atomic(&out_dir.join("run.json"), &json).map_err(io_err)?;
+    update(&mut summary, &stepper, &frames);
+    if let Err(e) = result {
+        // Leave a run.json that says why the run stopped (best effort: the error may well be
+        // that nothing can be written).
+        summary.outcome = Outcome::Failed(e.to_string());
+        let _ = write_summary(out_dir, &summary);
+        return Err(e);
+    }
+    write_summary(out_dir, &summary).map_err(io_err)?;
     Ok(summary)
+}
+
+/// Writes `DIR/run.json` atomically.
+fn write_summary(out_dir: &Path, summary: &RunSummary) -> std::io::Result<()> {
+    let json = serde_json::to_vec_pretty(summary).expect("summary serialises");
+    crate::output::atomic::write_atomic(&out_dir.join("run.json"), &json)
 }
 
 /// Draws every figure of a finished (or stopped) run in `dir` into `dir/figures/`: the

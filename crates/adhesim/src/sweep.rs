@@ -354,6 +354,8 @@ fn write_summary(
                 row.push(match &s.outcome {
                     Outcome::Finished => "finished".to_string(),
                     Outcome::Failed(m) => csv_field(&format!("failed: {m}")),
+                    Outcome::Interrupted => "interrupted".to_string(),
+                    Outcome::Running => "running".to_string(),
                 });
                 row.push(format!("{:e}", s.t_reached));
                 row.push(s.steps.to_string());

@@ -130,6 +130,34 @@ pub struct State {
     pub step: usize,
 }
 
+/// Everything a [`Stepper`] carries from one step to the next: restoring it into a fresh
+/// stepper of the same problem continues the run exactly as if it had not stopped.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Snapshot {
+    /// Time [s].
+    pub t: f64,
+    /// Number of committed steps.
+    pub step: usize,
+    /// Nodal displacements [m].
+    pub u: Vec<f64>,
+    /// Nodal velocities [m/s].
+    pub v: Vec<f64>,
+    /// Step size the next step will try before clipping to the end time [s].
+    pub dt: f64,
+    /// Steps since the last cut-back (Δt doubles back after two).
+    pub good_steps_since_cut: usize,
+    /// Loads and gravity at the start of the next step [N].
+    pub f_ext0: Vec<f64>,
+    /// Internal force at the start of the next step [N].
+    pub f_int0: Vec<f64>,
+    /// Work done on the bodies since t = 0 [J].
+    pub external_work: f64,
+    /// Strain energy of the committed state [J].
+    pub last_internal: f64,
+    /// Committed contact state per pair and slave node.
+    pub contact: Vec<Vec<NodeContact>>,
+}
+
 /// Advances a [`Problem`] in time.
 pub struct Stepper {
     /// The problem being solved.
@@ -313,6 +341,65 @@ impl Stepper {
         f
     }
 
+    /// The state carried from one step to the next (for checkpoints).
+    pub fn snapshot(&self) -> Snapshot {
+        Snapshot {
+            t: self.state.t,
+            step: self.state.step,
+            u: self.state.u.clone(),
+            v: self.state.v.clone(),
+            dt: self.dt,
+            good_steps_since_cut: self.good_steps_since_cut,
+            f_ext0: self.f_ext0.clone(),
+            f_int0: self.f_int0.clone(),
+            external_work: self.external_work,
+            last_internal: self.last_internal,
+            contact: self.contact.clone(),
+        }
+    }
+
+    /// Continues from `snap`, taken from a stepper of the same problem. Fails, changing
+    /// nothing, when its sizes do not fit this problem.
+    pub fn restore(&mut self, snap: Snapshot) -> Result<(), String> {
+        let n = self.disc.num_dofs();
+        for (what, len) in [
+            ("u", snap.u.len()),
+            ("v", snap.v.len()),
+            ("f_ext0", snap.f_ext0.len()),
+            ("f_int0", snap.f_int0.len()),
+        ] {
+            if len != n {
+                return Err(format!(
+                    "{what} has {len} values but the problem has {n} degrees of freedom"
+                ));
+            }
+        }
+        let sizes: Vec<usize> = self.contact.iter().map(Vec::len).collect();
+        let got: Vec<usize> = snap.contact.iter().map(Vec::len).collect();
+        if sizes != got {
+            return Err(format!(
+                "contact state has {got:?} slave nodes per pair but the problem has {sizes:?}"
+            ));
+        }
+        if !(snap.dt > 0.0) || !snap.t.is_finite() {
+            return Err(format!("invalid time {} or step size {}", snap.t, snap.dt));
+        }
+        self.state = State {
+            t: snap.t,
+            u: snap.u,
+            v: snap.v,
+            step: snap.step,
+        };
+        self.dt = snap.dt;
+        self.good_steps_since_cut = snap.good_steps_since_cut;
+        self.f_ext0 = snap.f_ext0;
+        self.f_int0 = snap.f_int0;
+        self.external_work = snap.external_work;
+        self.last_internal = snap.last_internal;
+        self.contact = snap.contact;
+        Ok(())
+    }
+
     /// True when the end time has been reached.
     pub fn finished(&self) -> bool {
         self.state.t >= self.problem.time.t_end * (1.0 - 1e-12)
@@ -453,6 +540,11 @@ impl Stepper {
             self.state.t = self.problem.time.t_end;
         }
         self.state.step += 1;
+    }
+
+    /// Drops the Delassus operator kept for reuse (the next contact solve builds its own).
+    pub fn forget_delassus(&mut self) {
+        self.delassus_cache = None;
     }
 
     /// One Newton solve over [t, t+dt]; Err with the reason on failure.

@@ -137,6 +137,38 @@ impl TempFile {
     }
 }
 
+/// Removes the temporary files that writers in this module leave in `dir` when their
+/// process is killed between creating and renaming them (`.<name>.<pid>.<n>.tmp…`). Returns
+/// how many were removed. For a directory no running process is writing to, such as the
+/// output of a run being resumed.
+pub fn remove_stale_temps(dir: &Path) -> io::Result<usize> {
+    let mut removed = 0;
+    for entry in fs::read_dir(dir)? {
+        let entry = entry?;
+        let name = entry.file_name();
+        let Some(name) = name.to_str() else { continue };
+        if is_temp_name(name) && entry.file_type()?.is_file() {
+            fs::remove_file(entry.path())?;
+            removed += 1;
+        }
+    }
+    Ok(removed)
+}
+
+/// Whether `name` has the form `.<target>.<pid>.<n>.tmp<suffix>` of [`TempFile::create`].
+fn is_temp_name(name: &str) -> bool {
+    let Some(rest) = name.strip_prefix('.') else {
+        return false;
+    };
+    let Some(i) = rest.rfind(".tmp") else {
+        return false;
+    };
+    let mut parts = rest[..i].rsplitn(3, '.');
+    let digits =
+        |s: Option<&str>| s.is_some_and(|s| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit()));
+    digits(parts.next()) && digits(parts.next()) && parts.next().is_some_and(|t| !t.is_empty())
+}
+
 /// The directory holding `path` (`.` for a bare file name).
 fn parent_dir(path: &Path) -> PathBuf {
     match path.parent() {
@@ -290,6 +322,32 @@ mod tests {
         tmp.persist(&target).unwrap();
         assert_eq!(fs::read(&target).unwrap(), b"kept");
         assert_eq!(dir.entries(), vec!["plot.png".to_string()]);
+    }
+
+    #[test]
+    fn stale_temporary_files_are_recognised_and_removed() {
+        let dir = TestDir::new("atomic-stale");
+        let target = dir.path().join("frame_00001.vtu");
+        write_atomic(&target, b"kept").unwrap();
+        let (tmp, file) = TempFile::create(&target, ".png").unwrap();
+        drop(file);
+        let tmp_name = tmp
+            .0
+            .path()
+            .file_name()
+            .unwrap()
+            .to_str()
+            .unwrap()
+            .to_string();
+        std::mem::forget(tmp); // as if the process had been killed
+        fs::write(dir.path().join(".hidden.txt"), b"not ours").unwrap();
+        fs::write(dir.path().join(".a.1.x.tmp"), b"not ours").unwrap();
+        assert!(is_temp_name(&tmp_name), "{tmp_name}");
+        assert_eq!(remove_stale_temps(dir.path()).unwrap(), 1);
+        assert_eq!(
+            dir.entries(),
+            vec![".a.1.x.tmp", ".hidden.txt", "frame_00001.vtu"]
+        );
     }
 
     #[test]

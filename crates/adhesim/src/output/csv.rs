@@ -66,6 +66,71 @@ impl HistoryWriter {
         })
     }
 
+    /// Reopens `path`, written by [`HistoryWriter::create`] with the same `columns`, keeps
+    /// its header and first `keep_rows` rows, drops everything after them and appends from
+    /// there on (a resumed run recomputes the dropped rows).
+    ///
+    /// Fails with [`io::ErrorKind::InvalidData`] if the header differs from `columns` or the
+    /// file holds fewer than `keep_rows` complete rows.
+    pub fn reopen<S: AsRef<str>>(
+        path: impl AsRef<Path>,
+        columns: &[S],
+        keep_rows: u64,
+    ) -> io::Result<Self> {
+        let path = path.as_ref().to_path_buf();
+        let text = fs::read(&path).map_err(|e| with_path(e, "cannot read", &path))?;
+        let mut lines = text.split_inclusive(|&b| b == b'\n');
+        let bad = |message: String| {
+            io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("{}: {message}", path.display()),
+            )
+        };
+        let header = lines
+            .next()
+            .filter(|l| l.ends_with(b"\n"))
+            .ok_or_else(|| bad("missing header line".into()))?;
+        let names = parse_header(trim_eol(&String::from_utf8_lossy(header)))
+            .map_err(|m| bad(format!("header: {m}")))?;
+        let expected: Vec<&str> = columns.iter().map(|c| c.as_ref()).collect();
+        if names != expected {
+            return Err(bad(format!(
+                "the columns {names:?} differ from those of this run {expected:?}"
+            )));
+        }
+        let mut keep = header.len();
+        let mut found = 0;
+        for line in lines {
+            if found == keep_rows || !line.ends_with(b"\n") {
+                break;
+            }
+            keep += line.len();
+            found += 1;
+        }
+        if found < keep_rows {
+            return Err(bad(format!(
+                "holds {found} complete rows, expected at least {keep_rows}"
+            )));
+        }
+        let file = fs::OpenOptions::new()
+            .write(true)
+            .open(&path)
+            .map_err(|e| with_path(e, "cannot open", &path))?;
+        file.set_len(keep as u64)
+            .map_err(|e| with_path(e, "cannot truncate", &path))?;
+        let mut file = file;
+        use std::io::Seek as _;
+        file.seek(io::SeekFrom::End(0))
+            .map_err(|e| with_path(e, "cannot seek in", &path))?;
+        Ok(HistoryWriter {
+            path,
+            file,
+            columns: expected.iter().map(|c| c.to_string()).collect(),
+            rows: keep_rows,
+            line: String::new(),
+        })
+    }
+
     /// Writes one row and hands it to the operating system before returning.
     ///
     /// A row whose length differs from the number of columns is rejected with
@@ -433,6 +498,34 @@ mod tests {
         let err = read_history(&missing).unwrap_err();
         assert_eq!(err.kind(), io::ErrorKind::NotFound);
         assert!(err.to_string().contains("missing.csv"), "{err}");
+    }
+
+    #[test]
+    fn reopen_keeps_the_first_rows_and_appends_after_them() {
+        let dir = TestDir::new("csv-reopen");
+        let path = dir.path().join("h.csv");
+        let mut w = HistoryWriter::create(&path, &["t", "u"]).unwrap();
+        for k in 0..5 {
+            w.append(&[k as f64, 2.0 * k as f64]).unwrap();
+        }
+        drop(w);
+        // A half-written row left by a killed run.
+        let mut text = fs::read_to_string(&path).unwrap();
+        text.push_str("5,1");
+        fs::write(&path, text).unwrap();
+        let mut w = HistoryWriter::reopen(&path, &["t", "u"], 3).unwrap();
+        assert_eq!(w.rows_written(), 3);
+        w.append(&[7.0, 8.0]).unwrap();
+        assert_eq!(
+            fs::read_to_string(&path).unwrap(),
+            "t,u\n0,0\n1,2\n2,4\n7,8\n"
+        );
+        drop(w);
+        let err = HistoryWriter::reopen(&path, &["t", "v"], 1).unwrap_err();
+        assert_eq!(err.kind(), io::ErrorKind::InvalidData);
+        assert!(err.to_string().contains("differ"), "{err}");
+        let err = HistoryWriter::reopen(&path, &["t", "u"], 9).unwrap_err();
+        assert!(err.to_string().contains("4 complete rows"), "{err}");
     }
 
     #[test]

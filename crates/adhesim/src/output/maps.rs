@@ -77,6 +77,22 @@ impl MapObserver {
     }
 }
 
+impl MapObserver {
+    /// Goes on after a checkpoint at time `t`: the maps of earlier times are written.
+    pub fn resume(dir: &Path, requests: &[MapRequest], t: f64) -> io::Result<Self> {
+        let mut m = MapObserver::new(dir, requests)?;
+        for (r, req) in requests.iter().enumerate() {
+            m.next[r] = req
+                .times
+                .iter()
+                .filter(|&&w| t >= w - 1e-9 * w.abs())
+                .count();
+            m.faces_written[r] = true;
+        }
+        Ok(m)
+    }
+}
+
 /// File stem of the map of `pair` at requested time `t`.
 fn map_stem(pair: &str, t: f64) -> String {
     format!("{pair}_t{t}")

@@ -65,6 +65,61 @@ impl FrameWriter {
     pub fn frames(&self) -> usize {
         self.frames
     }
+
+    /// What the writer needs to go on after a restart.
+    pub fn progress(&self) -> FrameProgress {
+        FrameProgress {
+            frames: self.frames,
+            next_time: self.next_time,
+            entries: self.pvd.entries().to_vec(),
+        }
+    }
+
+    /// Continues a collection in `dir` after `progress`: the PVD is rewritten with its
+    /// entries, and frames numbered from `progress.frames` on (left by the interrupted run
+    /// after its checkpoint) are removed; they are written again as the run goes on.
+    pub fn resume(
+        dir: &Path,
+        name: &str,
+        interval: f64,
+        progress: FrameProgress,
+    ) -> io::Result<Self> {
+        let vtu = dir.join("vtu");
+        std::fs::create_dir_all(&vtu)?;
+        let prefix = format!("{name}_");
+        for entry in std::fs::read_dir(&vtu)? {
+            let file = entry?.file_name();
+            let Some(file) = file.to_str() else { continue };
+            let index = file
+                .strip_prefix(&prefix)
+                .and_then(|r| r.strip_suffix(".vtu"))
+                .filter(|r| r.len() >= 5 && r.bytes().all(|b| b.is_ascii_digit()))
+                .and_then(|r| r.parse::<usize>().ok());
+            if index.is_some_and(|i| i >= progress.frames) {
+                std::fs::remove_file(vtu.join(file))?;
+            }
+        }
+        let pvd = vtk::PvdWriter::with_entries(dir.join(format!("{name}.pvd")), progress.entries)?;
+        Ok(FrameWriter {
+            dir: dir.to_path_buf(),
+            name: name.to_string(),
+            pvd,
+            interval,
+            next_time: progress.next_time,
+            frames: progress.frames,
+        })
+    }
+}
+
+/// How far a [`FrameWriter`] got: saved in checkpoints.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameProgress {
+    /// Frames written.
+    pub frames: usize,
+    /// Time of the next frame [s].
+    pub next_time: f64,
+    /// Entries of the PVD collection.
+    pub entries: Vec<vtk::PvdEntry>,
 }
 
 /// Per-body arrays of one frame.
@@ -336,6 +391,20 @@ impl HistoryObserver {
         Ok(HistoryObserver {
             writer: csv::HistoryWriter::create(path, &history_columns(problem))?,
         })
+    }
+}
+
+impl HistoryObserver {
+    /// Continues `path` after its first `rows` rows (see [`csv::HistoryWriter::reopen`]).
+    pub fn resume(path: &Path, problem: &Problem, rows: u64) -> io::Result<Self> {
+        Ok(HistoryObserver {
+            writer: csv::HistoryWriter::reopen(path, &history_columns(problem), rows)?,
+        })
+    }
+
+    /// Rows written (including those before a restart).
+    pub fn rows_written(&self) -> u64 {
+        self.writer.rows_written()
     }
 }
 

@@ -533,6 +533,17 @@ impl PvdWriter {
         Ok(writer)
     }
 
+    /// Continues a collection at `path` with `entries` already written (a resumed run) and
+    /// rewrites it with exactly those entries.
+    pub fn with_entries(path: impl Into<PathBuf>, entries: Vec<PvdEntry>) -> io::Result<Self> {
+        let writer = PvdWriter {
+            path: path.into(),
+            entries,
+        };
+        writer.rewrite()?;
+        Ok(writer)
+    }
+
     /// Appends the data file `file` (relative to the `.pvd` file's directory) for `time` and
     /// rewrites the collection.
     ///
