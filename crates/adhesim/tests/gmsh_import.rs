@@ -280,7 +280,7 @@ fn malformed_files_give_errors_with_file_and_line() {
 
     // Truncated in the middle of the nodes.
     let cut = text.find("$EndNodes").unwrap() - 200;
-    let e = read_bad("truncated.msh", text[..cut].as_bytes());
+    let e = read_bad("truncated.msh", &text.as_bytes()[..cut]);
     assert!(e.message.contains("end of file"), "{e}");
     assert!(matches!(e.location, Some(Location::Line(_))), "{e}");
 

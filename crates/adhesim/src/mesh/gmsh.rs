@@ -696,7 +696,7 @@ impl Parser<'_> {
             ));
         }
         let index = NodeIndex::build(&msh.node_tags);
-        if msh.node_tags.iter().any(|&t| t == 0) {
+        if msh.node_tags.contains(&0) {
             return Err(self.err_at(at_total, "node tag 0: Gmsh tags start at 1"));
         }
         {
@@ -733,7 +733,7 @@ impl Parser<'_> {
                     format!("{name} (Gmsh type {etype}) in a block of dimension {dim}: expected dimension {edim}"),
                 ));
             }
-            let supported = matches!(etype, 2 | 3 | 4 | 5) || dim <= 1;
+            let supported = (2..=5).contains(&etype) || dim <= 1;
             if !supported {
                 let fix = if matches!(etype, 6 | 7) {
                     "adhesim meshes hold hex8 and tet4 volumes only: remesh with hexahedra or tetrahedra"
