@@ -9,6 +9,7 @@ use crate::contact::law::DEFAULT_BETA_EPS;
 use crate::contact::{ContactPair, InterfaceLaw, Master, RccParams, RigidMotion, RigidShape};
 use crate::material::{self, Hyperelastic};
 use crate::mesh::generate::{self, FlatSide};
+use crate::mesh::{gmsh, quality};
 use crate::mesh::{Face, Mesh};
 use crate::problem::{
     Body, Dirichlet, MapRequest, NodalLoad, OutputSettings, Problem, Rotation, Table, TimeSettings,
@@ -95,9 +96,44 @@ struct FileBody {
     offset: Option<[f64; 3]>,
 }
 
+/// `mesh = { generator = ..., ... }` (a built-in mesh) or `mesh = { file = ..., ... }` (a
+/// Gmsh file).
+#[derive(Debug)]
+enum FileMesh {
+    Generated(FileGenerator),
+    File(FileMeshFile),
+}
+
+impl<'de> Deserialize<'de> for FileMesh {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let table = toml::Table::deserialize(d)?;
+        let (gen, file) = (table.contains_key("generator"), table.contains_key("file"));
+        let value = toml::Value::Table(table);
+        match (gen, file) {
+            (true, false) => value.try_into().map(FileMesh::Generated).map_err(D::Error::custom),
+            (false, true) => value.try_into().map(FileMesh::File).map_err(D::Error::custom),
+            (true, true) => Err(D::Error::custom(
+                "give either `generator` (a built-in mesh) or `file` (a Gmsh .msh file), not both",
+            )),
+            (false, false) => Err(D::Error::custom(
+                "a mesh needs `generator` (\"block\", \"disk\", \"half_disk\", \"quarter_hemisphere\") or `file` (a Gmsh MSH 4.1 file)",
+            )),
+        }
+    }
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileMeshFile {
+    file: PathBuf,
+    volumes: Option<Vec<String>>,
+    scale: Option<f64>,
+}
+
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields, tag = "generator", rename_all = "snake_case")]
-enum FileMesh {
+enum FileGenerator {
     Block {
         size: [f64; 3],
         divisions: [usize; 3],
@@ -753,8 +789,12 @@ fn validate_time(t: &FileTime, ctx: &Ctx) -> Result<TimeSettings, ScenarioError>
 const MAX_DIVISIONS: usize = 2000;
 
 fn build_mesh(m: &FileMesh, key: &str, ctx: &Ctx) -> Result<Mesh, ScenarioError> {
+    let m = match m {
+        FileMesh::Generated(g) => g,
+        FileMesh::File(f) => return import_mesh(f, key, ctx),
+    };
     Ok(match m {
-        FileMesh::Block { size, divisions } => {
+        FileGenerator::Block { size, divisions } => {
             for k in 0..3 {
                 ctx.positive(&format!("{key}.size[{k}]"), size[k])?;
                 ctx.count(
@@ -770,7 +810,7 @@ fn build_mesh(m: &FileMesh, key: &str, ctx: &Ctx) -> Result<Mesh, ScenarioError>
             }
             generate::block(*size, *divisions)
         }
-        FileMesh::Disk {
+        FileGenerator::Disk {
             radius,
             thickness,
             n_quarter,
@@ -782,7 +822,7 @@ fn build_mesh(m: &FileMesh, key: &str, ctx: &Ctx) -> Result<Mesh, ScenarioError>
             ctx.count(&format!("{key}.n_radial"), *n_radial, MAX_DIVISIONS)?;
             generate::disk(*radius, *thickness, *n_quarter, *n_radial)
         }
-        FileMesh::HalfDisk {
+        FileGenerator::HalfDisk {
             radius,
             thickness,
             n_quarter,
@@ -804,12 +844,81 @@ fn build_mesh(m: &FileMesh, key: &str, ctx: &Ctx) -> Result<Mesh, ScenarioError>
             };
             generate::half_disk(*radius, *thickness, *n_quarter, *n_radial, side)
         }
-        FileMesh::QuarterHemisphere { radius, n } => {
+        FileGenerator::QuarterHemisphere { radius, n } => {
             ctx.positive(&format!("{key}.radius"), *radius)?;
             ctx.count(&format!("{key}.n"), *n, MAX_DIVISIONS)?;
             generate::quarter_hemisphere(*radius, *n)
         }
     })
+}
+
+/// Reads a body's mesh from a Gmsh file, relative to the scenario's folder, scales it and
+/// checks its cells before anything runs.
+fn import_mesh(f: &FileMeshFile, key: &str, ctx: &Ctx) -> Result<Mesh, ScenarioError> {
+    let scale = ctx.positive(&format!("{key}.scale"), f.scale.unwrap_or(1.0))?;
+    let path = ctx
+        .file
+        .parent()
+        .map(|dir| dir.join(&f.file))
+        .unwrap_or_else(|| f.file.clone());
+    if !path.is_file() {
+        return Err(ctx.err(format!(
+            "`{key}.file`: no mesh file at {} (paths are relative to the scenario's folder)",
+            path.display()
+        )));
+    }
+    let fail = |e: gmsh::GmshError| ctx.err(format!("`{key}.file`: {e}"));
+    let msh = gmsh::read(&path).map_err(fail)?;
+    if let Some(sel) = &f.volumes {
+        let available = msh.physical_volumes();
+        let list = || {
+            if available.is_empty() {
+                "the file has no physical volumes".to_string()
+            } else {
+                format!(
+                    "its physical volumes are: {}",
+                    available
+                        .iter()
+                        .map(|v| format!("{v:?}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            }
+        };
+        if sel.is_empty() {
+            return Err(ctx.err(format!("`{key}.volumes` is empty: name at least one physical volume of {} ({}), or leave `volumes` out to take every volume element", path.display(), list())));
+        }
+        if let Some(v) = sel.iter().find(|v| !available.contains(v)) {
+            return Err(ctx.err(format!(
+                "`{key}.volumes`: {v:?} is not a physical volume of {}; {}",
+                path.display(),
+                list()
+            )));
+        }
+    }
+    let body = msh.body(f.volumes.as_deref()).map_err(fail)?;
+    let mut mesh = body.mesh;
+    for p in &mut mesh.nodes {
+        *p = p.map(|x| x * scale);
+    }
+    let bad = quality::inverted_cells(&mesh);
+    if !bad.is_empty() {
+        let mut tags: Vec<String> = bad
+            .iter()
+            .take(20)
+            .map(|&c| body.cell_tags[c].to_string())
+            .collect();
+        if bad.len() > 20 {
+            tags.push(format!("and {} more", bad.len() - 20));
+        }
+        return Err(ctx.err(format!(
+            "`{key}.file`: {} has {} inverted or degenerate element(s) (Jacobian ≤ 0); Gmsh element tags: {}",
+            path.display(),
+            bad.len(),
+            tags.join(", ")
+        )));
+    }
+    Ok(mesh)
 }
 
 fn build_material(

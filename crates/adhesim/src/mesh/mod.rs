@@ -12,6 +12,7 @@
 use std::collections::BTreeMap;
 
 pub mod generate;
+pub mod gmsh;
 pub mod quality;
 
 /// A boundary face of a cell: a bilinear quadrilateral or a linear triangle.
@@ -34,7 +35,7 @@ impl Face {
 }
 
 /// An unstructured mesh of one body.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
     /// Reference coordinates of the nodes [m].
     pub nodes: Vec<[f64; 3]>,
