@@ -330,6 +330,12 @@ pub fn run_with(
             }
         }
         summary.outcome = Outcome::Finished;
+        // A finished run has nothing to resume: its last periodic checkpoint goes.
+        match std::fs::remove_file(Checkpoint::path(out_dir)) {
+            Ok(()) => summary.checkpoint = None,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(io_err(e)),
+        }
         Ok(())
     })();
     if result.is_ok() && problem.output.figures && summary.outcome != Outcome::Interrupted {
