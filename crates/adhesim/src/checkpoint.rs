@@ -502,6 +502,7 @@ mod tests {
             tracks: vec![],
             output: crate::problem::OutputSettings {
                 frame_interval: 0.1,
+                ..Default::default()
             },
         };
         assert_eq!(fingerprint(&problem(1.0)), fingerprint(&problem(1.0)));
