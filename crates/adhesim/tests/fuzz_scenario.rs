@@ -5,7 +5,7 @@
 //! the TOML parser into validation and mesh building. An accepted problem also goes through
 //! the physical warnings.
 //!
-//! `ADHESIM_FUZZ_CASES` sets the number of cases (default 1500).
+//! `ADHESIM_FUZZ_CASES` sets the number of cases (default 20000).
 
 use adhesim::scenario::{parse, parse_with, LoadOptions};
 use proptest::prelude::*;
@@ -230,7 +230,7 @@ fn fuzz_cases() -> u32 {
     std::env::var("ADHESIM_FUZZ_CASES")
         .ok()
         .and_then(|v| v.parse().ok())
-        .unwrap_or(1500)
+        .unwrap_or(20000)
 }
 
 static ACCEPTED: AtomicUsize = AtomicUsize::new(0);
