@@ -199,33 +199,14 @@ fn contact_warnings(problem: &Problem, out: &mut Vec<String>) {
         }
         // Contact zone resolution under a rigid sphere or cylinder.
         if let Master::Rigid { shape, motion } = &pair.master {
-            let (radius, distance): (f64, Box<dyn Fn([f64; 3]) -> f64>) = match *shape {
-                RigidShape::Sphere { center, radius } => {
-                    (radius, Box::new(move |x| dist(x, center) - radius))
-                }
-                RigidShape::Cylinder {
-                    point,
-                    axis,
-                    radius,
-                } => (
-                    radius,
-                    Box::new(move |x| {
-                        let d = [x[0] - point[0], x[1] - point[1], x[2] - point[2]];
-                        let along = d[0] * axis[0] + d[1] * axis[1] + d[2] * axis[2];
-                        let r = [
-                            d[0] - along * axis[0],
-                            d[1] - along * axis[1],
-                            d[2] - along * axis[2],
-                        ];
-                        (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt() - radius
-                    }),
-                ),
+            let radius = match *shape {
+                RigidShape::Sphere { radius, .. } | RigidShape::Cylinder { radius, .. } => radius,
                 RigidShape::Plane { .. } => continue,
             };
             let gap = pair
                 .slave_nodes
                 .iter()
-                .map(|&n| distance(coord(n)))
+                .map(|&n| distance_outside(shape, coord(n)))
                 .fold(f64::INFINITY, f64::min)
                 .max(0.0);
             // Largest travel of the master: the displacement at every table time.
@@ -243,7 +224,7 @@ fn contact_warnings(problem: &Problem, out: &mut Vec<String>) {
                 })
                 .fold(0.0, f64::max);
             let depth = travel - gap;
-            if !(depth > 0.0) {
+            if depth.is_nan() || depth <= 0.0 {
                 continue;
             }
             let half_width = (2.0 * radius * depth).sqrt();
@@ -255,6 +236,29 @@ fn contact_warnings(problem: &Problem, out: &mut Vec<String>) {
                 ));
             }
         }
+    }
+}
+
+/// Distance of `x` outside a rigid sphere or cylinder in its reference position [m]
+/// (negative inside); 0 for a plane, which is not checked.
+fn distance_outside(shape: &RigidShape, x: [f64; 3]) -> f64 {
+    match *shape {
+        RigidShape::Sphere { center, radius } => dist(x, center) - radius,
+        RigidShape::Cylinder {
+            point,
+            axis,
+            radius,
+        } => {
+            let d = [x[0] - point[0], x[1] - point[1], x[2] - point[2]];
+            let along = d[0] * axis[0] + d[1] * axis[1] + d[2] * axis[2];
+            let r = [
+                d[0] - along * axis[0],
+                d[1] - along * axis[1],
+                d[2] - along * axis[2],
+            ];
+            (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt() - radius
+        }
+        RigidShape::Plane { .. } => 0.0,
     }
 }
 
