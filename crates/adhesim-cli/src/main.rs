@@ -192,6 +192,9 @@ fn check(path: &Path, opts: &adhesim::scenario::LoadOptions) -> ExitCode {
         let err = adhesim::time::SetupError::BadElements(bad);
         return fail_input(format!("{}: {err}", path.display()));
     }
+    for w in adhesim::warnings::physical_warnings(&problem) {
+        eprintln!("warning: {w}");
+    }
     let nodes: usize = problem.bodies.iter().map(|b| b.mesh.num_nodes()).sum();
     let cells: usize = problem.bodies.iter().map(|b| b.mesh.num_cells()).sum();
     println!(
@@ -248,6 +251,9 @@ fn run(
             "running"
         };
         eprintln!("{verb} {} → {}", path.display(), out.display());
+        for w in adhesim::warnings::physical_warnings(&problem) {
+            progress.message(&format!("warning: {w}"));
+        }
     }
     let summary =
         match adhesim::run::run_with(problem, Some(path), &out, progress.as_mut(), &control) {

@@ -20,6 +20,7 @@ pub mod run;
 pub mod scenario;
 pub mod sweep;
 pub mod time;
+pub mod warnings;
 
 /// 3×3 matrix of f64 (deformation gradients, stresses).
 pub type Mat3 = nalgebra::Matrix3<f64>;

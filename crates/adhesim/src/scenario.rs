@@ -431,6 +431,12 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
             )));
         }
         let mut mesh = build_mesh(&b.mesh, &format!("{key}.mesh"), ctx)?;
+        if mesh.num_cells() == 0 || mesh.num_nodes() == 0 {
+            return Err(ctx.err(format!(
+                "`{key}.mesh` of body {:?} has no elements; a body needs at least one hexahedron or tetrahedron",
+                b.name
+            )));
+        }
         if let Some(off) = b.offset {
             mesh.translate(ctx.finite3(&format!("{key}.offset"), off)?);
         }
@@ -599,10 +605,17 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
                 t.name
             )));
         }
+        if raw.tracks[..i].iter().any(|o| o.name == t.name) {
+            return Err(ctx.err(format!(
+                "`{key}.name`: the track name {:?} is used twice; names must be unique",
+                t.name
+            )));
+        }
         let bi = *body_index.get(&t.body).ok_or_else(|| {
             ctx.err(format!(
-                "`{key}.body` = {:?} is not a body of this scenario",
-                t.body
+                "`{key}.body` = {:?} is not a body of this scenario; bodies are: {}",
+                t.body,
+                body_index.keys().cloned().collect::<Vec<_>>().join(", ")
             ))
         })?;
         let mesh = &bodies[bi].mesh;
@@ -715,6 +728,11 @@ fn validate_time(t: &FileTime, ctx: &Ctx) -> Result<TimeSettings, ScenarioError>
     let d = TimeSettings::default();
     let t_end = ctx.positive("time.t_end", t.t_end)?;
     let dt = ctx.positive("time.dt", t.dt)?;
+    if dt > t_end {
+        return Err(ctx.err(format!(
+            "`time.dt` ({dt} s) must not exceed `time.t_end` ({t_end} s)"
+        )));
+    }
     let dt_min = ctx.positive(
         "time.dt_min",
         t.dt_min.unwrap_or((dt * 1e-6).min(d.dt_min.max(dt * 1e-9))),
@@ -788,6 +806,23 @@ fn validate_time(t: &FileTime, ctx: &Ctx) -> Result<TimeSettings, ScenarioError>
 /// would exhaust memory).
 const MAX_DIVISIONS: usize = 2000;
 
+/// Largest number of cells a generated mesh may have (a typo such as
+/// `divisions = [100000, 100000, 1]` would otherwise allocate for ever).
+const MAX_CELLS: u128 = 5_000_000;
+
+impl Ctx<'_> {
+    /// Rejects a generated mesh of more than [`MAX_CELLS`] cells before it is built.
+    fn cell_limit(&self, key: &str, what: &str, cells: u128) -> Result<(), ScenarioError> {
+        if cells > MAX_CELLS {
+            Err(self.err(format!(
+                "`{key}`: {what} give {cells} cells, more than the limit of {MAX_CELLS}; use fewer divisions"
+            )))
+        } else {
+            Ok(())
+        }
+    }
+}
+
 fn build_mesh(m: &FileMesh, key: &str, ctx: &Ctx) -> Result<Mesh, ScenarioError> {
     let m = match m {
         FileMesh::Generated(g) => g,
@@ -803,11 +838,12 @@ fn build_mesh(m: &FileMesh, key: &str, ctx: &Ctx) -> Result<Mesh, ScenarioError>
                     MAX_DIVISIONS,
                 )?;
             }
-            if divisions.iter().product::<usize>() > 20_000_000 {
-                return Err(ctx.err(format!(
-                    "`{key}.divisions` asks for more than 20 million elements"
-                )));
-            }
+            let cells: u128 = divisions.iter().map(|&d| d as u128).product();
+            ctx.cell_limit(
+                &format!("{key}.divisions"),
+                &format!("{divisions:?}"),
+                cells,
+            )?;
             generate::block(*size, *divisions)
         }
         FileGenerator::Disk {
@@ -820,6 +856,11 @@ fn build_mesh(m: &FileMesh, key: &str, ctx: &Ctx) -> Result<Mesh, ScenarioError>
             ctx.positive(&format!("{key}.thickness"), *thickness)?;
             ctx.count(&format!("{key}.n_quarter"), *n_quarter, MAX_DIVISIONS)?;
             ctx.count(&format!("{key}.n_radial"), *n_radial, MAX_DIVISIONS)?;
+            ctx.cell_limit(
+                key,
+                &format!("n_quarter = {n_quarter}, n_radial = {n_radial}"),
+                disk_cells(*n_quarter, *n_radial),
+            )?;
             generate::disk(*radius, *thickness, *n_quarter, *n_radial)
         }
         FileGenerator::HalfDisk {
@@ -833,6 +874,11 @@ fn build_mesh(m: &FileMesh, key: &str, ctx: &Ctx) -> Result<Mesh, ScenarioError>
             ctx.positive(&format!("{key}.thickness"), *thickness)?;
             ctx.count(&format!("{key}.n_quarter"), *n_quarter, MAX_DIVISIONS)?;
             ctx.count(&format!("{key}.n_radial"), *n_radial, MAX_DIVISIONS)?;
+            ctx.cell_limit(
+                key,
+                &format!("n_quarter = {n_quarter}, n_radial = {n_radial}"),
+                disk_cells(*n_quarter, *n_radial) / 2,
+            )?;
             let side = match flat_side.as_str() {
                 "top" => FlatSide::Top,
                 "bottom" => FlatSide::Bottom,
@@ -847,9 +893,21 @@ fn build_mesh(m: &FileMesh, key: &str, ctx: &Ctx) -> Result<Mesh, ScenarioError>
         FileGenerator::QuarterHemisphere { radius, n } => {
             ctx.positive(&format!("{key}.radius"), *radius)?;
             ctx.count(&format!("{key}.n"), *n, MAX_DIVISIONS)?;
+            ctx.cell_limit(
+                &format!("{key}.n"),
+                &format!("n = {n}"),
+                4 * (*n as u128).pow(3),
+            )?;
             generate::quarter_hemisphere(*radius, *n)
         }
     })
+}
+
+/// Cells of a disk O-grid: an n × n core and four n_radial × n rim blocks (n = n_quarter
+/// rounded up to even).
+fn disk_cells(n_quarter: usize, n_radial: usize) -> u128 {
+    let n = (n_quarter + n_quarter % 2) as u128;
+    n * n + 4 * n * n_radial as u128
 }
 
 /// Reads a body's mesh from a Gmsh file, relative to the scenario's folder, scales it and
@@ -1075,7 +1133,18 @@ fn build_contact(
     let sb = lookup(&format!("{key}.slave.body"), &c.slave.body)?;
     let slave_faces = face_set(&format!("{key}.slave.set"), sb, &c.slave.set)?;
     let mesh = &bodies[sb].mesh;
-    let local_nodes = mesh.node_sets[&c.slave.set].clone();
+    let local_nodes = match mesh.node_sets.get(&c.slave.set) {
+        Some(n) => n.clone(),
+        None => {
+            let mut n: Vec<usize> = slave_faces
+                .iter()
+                .flat_map(|f| f.nodes().to_vec())
+                .collect();
+            n.sort_unstable();
+            n.dedup();
+            n
+        }
+    };
     let area = tributary_areas(&slave_faces, &mesh.nodes, &local_nodes);
     let slave_quads = {
         let index: BTreeMap<usize, usize> = local_nodes

@@ -277,6 +277,26 @@ fn evaluate_parameters(doc: &Table) -> Result<BTreeMap<String, f64>, String> {
             }
         });
         if pending.len() == before {
+            // Nothing could be evaluated: either an unknown name, or parameters that wait on
+            // each other.
+            let waiting: Vec<&str> = pending.iter().map(|(n, _)| n.as_str()).collect();
+            let circular = pending.iter().all(|(_, expr)| {
+                tokenize(expr).is_ok_and(|tokens| {
+                    tokens
+                        .iter()
+                        .any(|t| matches!(t, Token::Ident(n) if waiting.contains(&n.as_str())))
+                })
+            });
+            if circular {
+                return Err(format!(
+                    "the parameters {} refer to each other in a circle; give one of them a number",
+                    waiting
+                        .iter()
+                        .map(|n| format!("`parameters.{n}`"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
+            }
             return Err(last_err);
         }
     }
@@ -596,7 +616,7 @@ mod tests {
     fn circular_parameters_are_an_error() {
         let mut doc: Table = toml::from_str("[parameters]\na = \"= b\"\nb = \"= a\"").unwrap();
         let e = prepare(&mut doc, None, &[]).unwrap_err();
-        assert!(e.contains("unknown name"), "{e}");
+        assert!(e.contains("circle") && e.contains("parameters.a"), "{e}");
     }
 
     #[test]

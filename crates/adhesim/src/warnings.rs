@@ -1,0 +1,416 @@
+//! Physical plausibility warnings: settings that are valid but are likely to give a poor or
+//! slow solution. They never stop a run; `adhesim run` and `adhesim check` print them once.
+//!
+//! - the time step is much longer than the time a pressure wave needs to cross the smallest
+//!   element, in a dynamic run whose loading is not slow (see [`DT_WAVE_RATIO`]);
+//! - the adhesive normal stiffness C_n of a contact pair is so large, compared with the
+//!   stiffness of the slave body at a node, that the contact solve is ill-conditioned
+//!   (see [`CN_STIFFNESS_RATIO`]);
+//! - a rigid sphere or cylinder indents the slave surface over a contact half-width of fewer
+//!   than [`MIN_ELEMENTS_ACROSS_CONTACT`] slave elements.
+
+use crate::contact::{Master, RigidShape};
+use crate::mesh::Mesh;
+use crate::problem::{Problem, Table};
+
+/// Warn when Δt exceeds this many times the wave transit time of the smallest element.
+pub const DT_WAVE_RATIO: f64 = 1000.0;
+
+/// The wave warning is left out when every prescribed speed (initial velocities, prescribed
+/// displacements, rigid-master motions) is below this fraction of the pressure-wave speed:
+/// the loading is then slow, and not resolving waves is intended.
+pub const SLOW_LOADING_MACH: f64 = 1e-3;
+
+/// Warn when C_n·A exceeds this many times E·h (per slave node).
+pub const CN_STIFFNESS_RATIO: f64 = 1e4;
+
+/// Warn when the estimated contact half-width holds fewer slave elements than this.
+pub const MIN_ELEMENTS_ACROSS_CONTACT: f64 = 3.0;
+
+/// The warnings for a validated problem, each stating the number that triggered it and the
+/// threshold. Empty when nothing looks suspicious.
+pub fn physical_warnings(problem: &Problem) -> Vec<String> {
+    let mut out = Vec::new();
+    wave_warning(problem, &mut out);
+    contact_warnings(problem, &mut out);
+    out
+}
+
+/// Smallest distance between two nodes of one cell (the shortest element edge) [m].
+fn smallest_edge(mesh: &Mesh) -> f64 {
+    let mut h = f64::INFINITY;
+    let mut visit = |cell: &[usize]| {
+        for a in 0..cell.len() {
+            for b in a + 1..cell.len() {
+                let d = dist(mesh.nodes[cell[a]], mesh.nodes[cell[b]]);
+                if d > 0.0 && d < h {
+                    h = d;
+                }
+            }
+        }
+    };
+    for c in &mesh.hexes {
+        visit(c);
+    }
+    for c in &mesh.tets {
+        visit(c);
+    }
+    h
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+/// Largest |slope| of a table [unit/s].
+fn max_rate(t: &Table) -> f64 {
+    let mut r: f64 = 0.0;
+    for k in 1..t.t.len() {
+        let dt = t.t[k] - t.t[k - 1];
+        if dt > 0.0 {
+            r = r.max(((t.v[k] - t.v[k - 1]) / dt).abs());
+        }
+    }
+    r
+}
+
+/// Largest speed of a translation given per component by tables [m/s].
+fn max_speed(tables: &[Table; 3]) -> f64 {
+    tables
+        .iter()
+        .map(|t| max_rate(t).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// The fastest prescribed speed of the problem [m/s]: initial velocities, prescribed
+/// translations and rotations (ω times the largest extent of the model), rigid-master motions.
+fn fastest_prescribed_speed(problem: &Problem) -> f64 {
+    let extent = {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for b in &problem.bodies {
+            for p in &b.mesh.nodes {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
+            }
+        }
+        if lo[0].is_finite() {
+            dist(lo, hi)
+        } else {
+            0.0
+        }
+    };
+    let mut v: f64 = 0.0;
+    for b in &problem.bodies {
+        let iv = b.initial_velocity;
+        v = v.max((iv[0] * iv[0] + iv[1] * iv[1] + iv[2] * iv[2]).sqrt());
+    }
+    for d in &problem.dirichlet {
+        v = v.max(max_speed(&d.translation));
+        if let Some(r) = &d.rotation {
+            v = v.max(max_rate(&r.angle) * extent);
+        }
+    }
+    for c in &problem.contacts {
+        if let Master::Rigid { motion, .. } = &c.master {
+            v = v.max(max_speed(&motion.translation));
+            if let Some(r) = &motion.rotation {
+                v = v.max(max_rate(&r.angle) * extent);
+            }
+        }
+    }
+    v
+}
+
+fn wave_warning(problem: &Problem, out: &mut Vec<String>) {
+    if problem.time.quasi_static {
+        return;
+    }
+    let dt = problem.time.dt;
+    // The body and element with the shortest transit time h / c.
+    let mut best: Option<(f64, f64, &str)> = None; // (transit time, wave speed, body)
+    for b in &problem.bodies {
+        let g = b.material.shear_modulus();
+        let k = b.material.bulk_modulus();
+        let c = ((k + 4.0 / 3.0 * g) / b.density).sqrt();
+        let h = smallest_edge(&b.mesh);
+        let transit = h / c;
+        if transit.is_finite() && transit > 0.0 && best.is_none_or(|(t, _, _)| transit < t) {
+            best = Some((transit, c, &b.name));
+        }
+    }
+    let Some((transit, c, body)) = best else {
+        return;
+    };
+    let ratio = dt / transit;
+    if ratio <= DT_WAVE_RATIO {
+        return;
+    }
+    let v = fastest_prescribed_speed(problem);
+    if v < SLOW_LOADING_MACH * c && problem.loads.is_empty() {
+        // Slow prescribed motion and no applied forces: not resolving waves is intended.
+        return;
+    }
+    out.push(format!(
+        "Δt = {dt:.3e} s is {ratio:.0} times (warning above {DT_WAVE_RATIO:.0}) the time a pressure wave needs to cross the smallest element ({transit:.3e} s; body {body:?}, wave speed {c:.4} m/s): inertia effects at the element scale are not resolved (fine for slow loading; for impact or waves reduce dt)"
+    ));
+}
+
+fn contact_warnings(problem: &Problem, out: &mut Vec<String>) {
+    let offsets = problem.node_offsets();
+    let body_of = |global: usize| -> usize { offsets.partition_point(|&o| o <= global) - 1 };
+    for pair in &problem.contacts {
+        let Some(&first) = pair.slave_nodes.first() else {
+            continue;
+        };
+        let bi = body_of(first);
+        let body = &problem.bodies[bi];
+        let coord = |global: usize| body.mesh.nodes[global - offsets[bi]];
+        let h = mean_slave_edge(pair, body, offsets[bi]);
+        if !(h > 0.0 && h.is_finite()) {
+            continue;
+        }
+        // Stiff adhesive links.
+        if let Some(a) = &pair.law.adhesion {
+            let areas: Vec<f64> = pair
+                .slave_area
+                .iter()
+                .copied()
+                .filter(|a| *a > 0.0)
+                .collect();
+            if !areas.is_empty() {
+                let area = areas.iter().sum::<f64>() / areas.len() as f64;
+                let g = body.material.shear_modulus();
+                let k = body.material.bulk_modulus();
+                let e = 9.0 * k * g / (3.0 * k + g);
+                let link = a.cn * area;
+                let body_stiffness = e * h;
+                let ratio = link / body_stiffness;
+                if ratio > CN_STIFFNESS_RATIO {
+                    out.push(format!(
+                        "contact {:?}: the adhesive normal stiffness per slave node C_n·A = {link:.3e} N/m (C_n = {:.3e} N/m³, mean tributary area {area:.3e} m²) is {ratio:.3e} times (warning above {CN_STIFFNESS_RATIO:.0e}) the body's stiffness per node E·h = {body_stiffness:.3e} N/m (E = {e:.3e} Pa, mean slave edge {h:.3e} m): the contact solve will be ill-conditioned and may need many sweeps or Δt cut-backs; a smaller C_n gives nearly the same response",
+                        pair.name, a.cn
+                    ));
+                }
+            }
+        }
+        // Contact zone resolution under a rigid sphere or cylinder.
+        if let Master::Rigid { shape, motion } = &pair.master {
+            let radius = match *shape {
+                RigidShape::Sphere { radius, .. } | RigidShape::Cylinder { radius, .. } => radius,
+                RigidShape::Plane { .. } => continue,
+            };
+            let gap = pair
+                .slave_nodes
+                .iter()
+                .map(|&n| distance_outside(shape, coord(n)))
+                .fold(f64::INFINITY, f64::min)
+                .max(0.0);
+            // Largest travel of the master: the displacement at every table time.
+            let mut times: Vec<f64> = motion
+                .translation
+                .iter()
+                .flat_map(|t| t.t.iter().copied())
+                .collect();
+            times.push(0.0);
+            let travel = times
+                .iter()
+                .map(|&t| {
+                    let u: [f64; 3] = std::array::from_fn(|k| motion.translation[k].at(t));
+                    (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt()
+                })
+                .fold(0.0, f64::max);
+            let depth = travel - gap;
+            if depth.is_nan() || depth <= 0.0 {
+                continue;
+            }
+            let half_width = (2.0 * radius * depth).sqrt();
+            let across = half_width / h;
+            if across < MIN_ELEMENTS_ACROSS_CONTACT {
+                out.push(format!(
+                    "contact {:?}: the contact half-width under the rigid master, about √(2 R d) = {half_width:.3e} m (R = {radius:.3e} m, indentation d = {depth:.3e} m), spans {across:.2} slave elements (mean slave edge {h:.3e} m; warning below {MIN_ELEMENTS_ACROSS_CONTACT:.0}): the mesh is too coarse to resolve the contact zone; refine the slave surface",
+                    pair.name
+                ));
+            }
+        }
+    }
+}
+
+/// Distance of `x` outside a rigid sphere or cylinder in its reference position [m]
+/// (negative inside); 0 for a plane, which is not checked.
+fn distance_outside(shape: &RigidShape, x: [f64; 3]) -> f64 {
+    match *shape {
+        RigidShape::Sphere { center, radius } => dist(x, center) - radius,
+        RigidShape::Cylinder {
+            point,
+            axis,
+            radius,
+        } => {
+            let d = [x[0] - point[0], x[1] - point[1], x[2] - point[2]];
+            let along = d[0] * axis[0] + d[1] * axis[1] + d[2] * axis[2];
+            let r = [
+                d[0] - along * axis[0],
+                d[1] - along * axis[1],
+                d[2] - along * axis[2],
+            ];
+            (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt() - radius
+        }
+        RigidShape::Plane { .. } => 0.0,
+    }
+}
+
+/// Mean edge length of the slave faces of a pair [m]: over the edges of the faces whose
+/// nodes are all slave nodes.
+fn mean_slave_edge(
+    pair: &crate::contact::ContactPair,
+    body: &crate::problem::Body,
+    offset: usize,
+) -> f64 {
+    let mut sum = 0.0;
+    let mut count = 0usize;
+    for q in &pair.slave_quads {
+        let nodes: Vec<usize> = {
+            let mut v = q.to_vec();
+            v.dedup();
+            if v.len() > 1 && v[0] == v[v.len() - 1] {
+                v.pop();
+            }
+            v
+        };
+        for i in 0..nodes.len() {
+            let (a, b) = (nodes[i], nodes[(i + 1) % nodes.len()]);
+            let (Some(&ga), Some(&gb)) = (pair.slave_nodes.get(a), pair.slave_nodes.get(b)) else {
+                continue;
+            };
+            let (Some(pa), Some(pb)) = (
+                body.mesh.nodes.get(ga.wrapping_sub(offset)),
+                body.mesh.nodes.get(gb.wrapping_sub(offset)),
+            ) else {
+                continue;
+            };
+            sum += dist(*pa, *pb);
+            count += 1;
+        }
+    }
+    if count == 0 {
+        f64::NAN
+    } else {
+        sum / count as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn problem(text: &str) -> Problem {
+        crate::scenario::parse(text, Path::new("test.toml")).unwrap()
+    }
+
+    const LAYER: &str = r#"
+[[body]]
+name = "layer"
+mesh = { generator = "block", size = [0.03, 0.003, 0.001], divisions = [DIV, 6, 1] }
+material = { model = "blatz-ko", g = 16e6 }
+density = 1000.0
+plane_strain = true
+
+[[boundary]]
+body = "layer"
+set = "bottom"
+fix = ["x", "y", "z"]
+"#;
+
+    fn layer(div: usize) -> String {
+        LAYER.replace("DIV", &div.to_string())
+    }
+
+    fn indentation(div: usize, cn: f64, depth: f64, mode: &str, dt: f64) -> String {
+        format!(
+            r#"
+[time]
+t_end = 4.0
+dt = {dt}
+mode = "{mode}"
+{}
+[[contact]]
+name = "indentor"
+slave = {{ body = "layer", set = "top" }}
+master = {{ rigid = "cylinder", point = [0.015, 0.018, 0.0], axis = [0.0, 0.0, 1.0], radius = 0.015 }}
+motion = {{ displacement = {{ y = [[0.0, 0.0], [1.0, {}], [4.0, 0.0]] }} }}
+friction = 0.0
+adhesion = {{ w = 20.0, cn = {cn:e}, ct = 2e9, b = 0.1 }}
+"#,
+            layer(div),
+            -depth
+        )
+    }
+
+    fn has(w: &[String], what: &str) -> bool {
+        w.iter().any(|s| s.contains(what))
+    }
+
+    #[test]
+    fn shipped_like_indentation_gives_no_warning() {
+        let w = physical_warnings(&problem(&indentation(60, 2e9, 1e-3, "dynamic", 0.02)));
+        assert!(w.is_empty(), "{w:?}");
+    }
+
+    #[test]
+    fn long_step_under_fast_loading_warns_about_waves() {
+        // 1 mm in 1 ms: 1 m/s, far from slow against c ≈ 219 m/s.
+        let text = indentation(60, 2e9, 1e-3, "dynamic", 0.02)
+            .replace("[1.0, ", "[1e-3, ")
+            .replace("[4.0, 0.0]", "[4e-3, 0.0]");
+        let w = physical_warnings(&problem(&text));
+        assert!(has(&w, "pressure wave"), "{w:?}");
+        assert!(has(&w, "warning above 1000"), "{w:?}");
+        // The same in quasi-static mode, or with a short step: no wave warning.
+        let qs = text.replace("\"dynamic\"", "\"quasi-static\"");
+        assert!(!has(&physical_warnings(&problem(&qs)), "pressure wave"));
+        let short = text.replace("dt = 0.02", "dt = 1e-6");
+        assert!(!has(&physical_warnings(&problem(&short)), "pressure wave"));
+    }
+
+    #[test]
+    fn initial_velocity_counts_as_fast_loading() {
+        let text = format!(
+            "[time]\nt_end = 1.0\ndt = 0.01\n{}",
+            layer(10).replace("plane_strain = true", "initial_velocity = [0.0, -1.0, 0.0]")
+        );
+        let w = physical_warnings(&problem(&text));
+        assert!(has(&w, "pressure wave"), "{w:?}");
+        let slow = text.replace("-1.0", "-1e-4");
+        assert!(physical_warnings(&problem(&slow)).is_empty());
+    }
+
+    #[test]
+    fn stiff_adhesive_links_warn() {
+        let w = physical_warnings(&problem(&indentation(60, 2e15, 1e-3, "quasi-static", 0.02)));
+        assert!(has(&w, "ill-conditioned"), "{w:?}");
+        assert!(has(&w, "1e4"), "{w:?}");
+        let w = physical_warnings(&problem(&indentation(60, 2e11, 1e-3, "quasi-static", 0.02)));
+        assert!(!has(&w, "ill-conditioned"), "{w:?}");
+    }
+
+    #[test]
+    fn coarse_mesh_under_a_rigid_cylinder_warns() {
+        // 6 elements over 30 mm: h ≈ 2.9 mm mean edge, a = √(2·15·0.1) mm ≈ 1.7 mm.
+        let w = physical_warnings(&problem(&indentation(6, 2e9, 1e-4, "quasi-static", 0.02)));
+        assert!(has(&w, "too coarse"), "{w:?}");
+        assert!(has(&w, "warning below 3"), "{w:?}");
+        // Fine mesh, deep indentation: resolved.
+        let w = physical_warnings(&problem(&indentation(120, 2e9, 1e-3, "quasi-static", 0.02)));
+        assert!(!has(&w, "too coarse"), "{w:?}");
+        // A rigid plane is never checked.
+        let plane = indentation(6, 2e9, 1e-4, "quasi-static", 0.02).replace(
+            r#"rigid = "cylinder", point = [0.015, 0.018, 0.0], axis = [0.0, 0.0, 1.0], radius = 0.015"#,
+            r#"rigid = "plane", point = [0.0, 0.003, 0.0], normal = [0.0, -1.0, 0.0]"#,
+        );
+        assert!(!has(&physical_warnings(&problem(&plane)), "too coarse"));
+    }
+}
