@@ -373,6 +373,8 @@ pub fn parse_with(
         .map_err(|e| ctx.err(format!("{}\n{hint}", e.to_string().trim_end())))?;
     let prepared = prepare::prepare(&mut doc, options.variant.as_deref(), &options.overrides)
         .map_err(|e| ctx.err(e))?;
+    // A document that pre-processing left as written is read from the text once more, so
+    // that type errors point at their line; a changed one can only be read from the value.
     let raw: FileScenario = if prepared.changed {
         let applied: Vec<String> = options
             .variant

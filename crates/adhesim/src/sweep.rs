@@ -225,14 +225,19 @@ pub fn run_sweep(
             .cloned()
             .collect(),
     };
-    for c in &cases {
-        crate::scenario::load_with(scenario, &case_options(c)).map_err(|source| {
-            SweepError::Scenario {
-                label: c.label.clone(),
-                source,
-            }
-        })?;
-    }
+    // Each case is loaded once: here, so that a bad value stops the sweep before anything
+    // runs, and the worker that runs it takes it from its slot.
+    let problems = cases
+        .iter()
+        .map(|c| {
+            crate::scenario::load_with(scenario, &case_options(c))
+                .map(|p| Mutex::new(Some(p)))
+                .map_err(|source| SweepError::Scenario {
+                    label: c.label.clone(),
+                    source,
+                })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
     std::fs::create_dir_all(out_dir).map_err(|source| SweepError::Io {
         path: out_dir.to_path_buf(),
         source,
@@ -248,7 +253,11 @@ pub fn run_sweep(
                 let i = next.fetch_add(1, Ordering::SeqCst);
                 let Some(case) = cases.get(i) else { break };
                 progress.started(case, total);
-                let result = run_case(scenario, case, &case_options(case), options, out_dir);
+                let problem = problems[i].lock().ok().and_then(|mut p| p.take());
+                let result = match problem {
+                    Some(problem) => run_case(scenario, case, problem, options, out_dir),
+                    None => Err("the case's scenario is not available".into()),
+                };
                 progress.finished(case, total, &result);
                 if let Ok(mut r) = results.lock() {
                     r[i] = Some(result);
@@ -262,8 +271,12 @@ pub fn run_sweep(
         .into_iter()
         .map(|r| r.unwrap_or_else(|| Err("the case did not run".into())))
         .collect();
-    write_summary(out_dir, axes, &cases, &results)?;
-    let figures = draw_comparison(out_dir, &cases)?;
+    let histories: Vec<Option<History>> = cases
+        .iter()
+        .map(|c| read_history(out_dir.join(&c.dir_name).join("history.csv")).ok())
+        .collect();
+    write_summary(out_dir, axes, &cases, &results, &histories)?;
+    let figures = draw_comparison(out_dir, &cases, &histories)?;
     Ok(SweepSummary {
         cases,
         results,
@@ -275,11 +288,10 @@ pub fn run_sweep(
 fn run_case(
     scenario: &Path,
     case: &Case,
-    load: &LoadOptions,
+    problem: crate::problem::Problem,
     options: &SweepOptions,
     out_dir: &Path,
 ) -> Result<RunSummary, String> {
-    let problem = crate::scenario::load_with(scenario, load).map_err(|e| e.to_string())?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(options.threads_per_case.max(1))
         .build()
@@ -298,9 +310,21 @@ fn csv_field(s: &str) -> String {
     }
 }
 
-/// Whether a history column is a tracked quantity (a track's or a pair's field).
-fn is_tracked(column: &str) -> bool {
-    column.contains('.')
+/// A run's history: column names and rows.
+pub type History = (Vec<String>, Vec<Vec<f64>>);
+
+/// The columns of the histories that satisfy `keep`: their union over the cases, in
+/// first-seen order. Tracked quantities (a track's or a pair's fields) hold a dot.
+fn columns_where(histories: &[Option<History>], keep: impl Fn(&str) -> bool) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for (cols, _) in histories.iter().flatten() {
+        for c in cols {
+            if keep(c) && !out.contains(c) {
+                out.push(c.clone());
+            }
+        }
+    }
+    out
 }
 
 fn write_summary(
@@ -308,20 +332,9 @@ fn write_summary(
     axes: &[Axis],
     cases: &[Case],
     results: &[Result<RunSummary, String>],
+    histories: &[Option<History>],
 ) -> Result<(), SweepError> {
-    // Tracked columns: the union over cases, in first-seen order.
-    let histories: Vec<Option<(Vec<String>, Vec<Vec<f64>>)>> = cases
-        .iter()
-        .map(|c| read_history(out_dir.join(&c.dir_name).join("history.csv")).ok())
-        .collect();
-    let mut tracked: Vec<String> = Vec::new();
-    for (cols, _) in histories.iter().flatten() {
-        for c in cols {
-            if is_tracked(c) && !tracked.contains(c) {
-                tracked.push(c.clone());
-            }
-        }
-    }
+    let tracked = columns_where(histories, |c| c.contains('.'));
     let mut header = vec!["case".to_string(), "dir".to_string()];
     header.extend(axes.iter().map(|a| a.key.clone()));
     header.extend(
@@ -346,7 +359,7 @@ fn write_summary(
         .collect::<Vec<_>>()
         .join(",");
     text.push('\n');
-    for ((case, result), history) in cases.iter().zip(results).zip(&histories) {
+    for ((case, result), history) in cases.iter().zip(results).zip(histories) {
         let mut row = vec![(case.index + 1).to_string(), csv_field(&case.dir_name)];
         row.extend(case.texts.iter().map(|t| csv_field(t)));
         match result {
@@ -396,30 +409,16 @@ fn write_summary(
         .map_err(|source| SweepError::Io { path, source })
 }
 
-/// One figure per tracked quantity with one curve per case.
-pub fn draw_comparison(out_dir: &Path, cases: &[Case]) -> Result<Vec<PathBuf>, SweepError> {
-    let histories: Vec<(String, Option<(Vec<String>, Vec<Vec<f64>>)>)> = cases
-        .iter()
-        .map(|c| {
-            (
-                c.label.clone(),
-                read_history(out_dir.join(&c.dir_name).join("history.csv")).ok(),
-            )
-        })
-        .collect();
-    let mut tracked: Vec<String> = Vec::new();
-    for (_, h) in &histories {
-        if let Some((cols, _)) = h {
-            for c in cols {
-                let plotted = c
-                    .rsplit_once('.')
-                    .is_some_and(|(_, f)| crate::output::figures::field_label(f).is_some());
-                if plotted && !tracked.contains(c) {
-                    tracked.push(c.clone());
-                }
-            }
-        }
-    }
+/// One figure per tracked quantity with one curve per case, from the cases' histories.
+pub fn draw_comparison(
+    out_dir: &Path,
+    cases: &[Case],
+    histories: &[Option<History>],
+) -> Result<Vec<PathBuf>, SweepError> {
+    let tracked = columns_where(histories, |c| {
+        c.rsplit_once('.')
+            .is_some_and(|(_, f)| crate::output::figures::field_label(f).is_some())
+    });
     let fig_dir = out_dir.join("figures");
     std::fs::create_dir_all(&fig_dir).map_err(|source| SweepError::Io {
         path: fig_dir.clone(),
@@ -428,7 +427,7 @@ pub fn draw_comparison(out_dir: &Path, cases: &[Case]) -> Result<Vec<PathBuf>, S
     let mut written = Vec::new();
     for column in &tracked {
         let mut series = Vec::new();
-        for (label, h) in &histories {
+        for (case, h) in cases.iter().zip(histories) {
             let Some((cols, rows)) = h else { continue };
             let (Some(t), Some(k)) = (
                 cols.iter().position(|c| c == "t"),
@@ -437,7 +436,7 @@ pub fn draw_comparison(out_dir: &Path, cases: &[Case]) -> Result<Vec<PathBuf>, S
                 continue;
             };
             series.push(Series {
-                label: label.clone(),
+                label: case.label.clone(),
                 x: rows.iter().map(|r| r[t]).collect(),
                 y: rows.iter().map(|r| r[k]).collect(),
             });

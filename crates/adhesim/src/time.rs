@@ -10,7 +10,7 @@
 use crate::assembly::{BadElement, Discretisation};
 use crate::contact::detect::{detect, ContactPoint};
 use crate::contact::law::{BondState, ContactState, PointSolution};
-use crate::contact::solve::{delassus, delassus_columns, gauss_seidel, Delassus};
+use crate::contact::solve::{delassus, gauss_seidel, Delassus};
 use crate::linalg::{LinalgError, SparseCholesky};
 use crate::problem::Problem;
 use std::sync::Arc;
@@ -613,7 +613,9 @@ impl Stepper {
         let mut last_correction_negligible = false;
         let mut prev_du_norm: Option<f64> = None;
         let mut delassus_builds = 0usize;
-        let mut delassus_checked_in_step = 0usize;
+        // Whether this attempt has built or checked the Delassus operator in use.
+        let mut delassus_checked = false;
+        let delassus_key = delassus_key(&points, dt);
         for iter in 1..=ts.max_newton {
             let clock = std::time::Instant::now();
             let asm = self.disc.assemble(&u, true);
@@ -754,16 +756,15 @@ impl Stepper {
                 let du_norm = norm(&du);
                 let slow = prev_du_norm.is_some_and(|p| du_norm > DELASSUS_REUSE_RATIO * p);
                 prev_du_norm = Some(du_norm);
-                let key = delassus_key(&points, dt);
-                let mut reusable = matches!(&self.delassus_cache, Some((k, _)) if *k == key);
+                let mut reusable =
+                    matches!(&self.delassus_cache, Some((k, _)) if *k == delassus_key);
                 // A W from an earlier step, or a slow convergence, is checked before reuse.
-                if reusable && (slow || delassus_checked_in_step == 0) {
-                    delassus_checked_in_step += 1;
-                    // Slow convergence comes from the nonsmooth contact laws as often as from
-                    // a stale W: probe three columns of the current W (the point carrying the
-                    // largest force) and rebuild only when they differ from the cached ones.
-                    // At the first iteration of a step r_contact is still zero and the probe
-                    // is the first point.
+                // Slow convergence comes from the nonsmooth contact laws as often as from a
+                // stale W: probe three columns of the current W (at the point carrying the
+                // largest force; the first point while r_contact is still zero) and rebuild
+                // only when they differ from the cached ones.
+                if reusable && (slow || !delassus_checked) {
+                    delassus_checked = true;
                     let probe = r_contact
                         .iter()
                         .enumerate()
@@ -771,24 +772,15 @@ impl Stepper {
                         .map(|(p, _)| p)
                         .unwrap_or(0);
                     let cached = &self.delassus_cache.as_ref().expect("checked").1;
-                    let fresh = delassus_columns(&points, probe, &mut self.chol, &self.constrained);
-                    let m = cached.m;
-                    let (mut diff, mut size) = (0.0f64, 0.0f64);
-                    for c in 0..3 {
-                        for row in 0..m {
-                            let a = fresh[c * m + row];
-                            let b = cached.w[row * m + 3 * probe + c];
-                            diff += (a - b) * (a - b);
-                            size += a * a;
-                        }
-                    }
-                    reusable = diff <= DELASSUS_STALE_TOL * DELASSUS_STALE_TOL * size;
+                    reusable =
+                        cached.probed_change(&points, probe, &mut self.chol, &self.constrained)
+                            <= DELASSUS_STALE_TOL;
                 }
                 if !reusable {
                     let del = delassus(&points, &mut self.chol, &self.constrained);
-                    self.delassus_cache = Some((key, del));
+                    self.delassus_cache = Some((delassus_key.clone(), del));
                     delassus_builds += 1;
-                    delassus_checked_in_step += 1;
+                    delassus_checked = true;
                 }
                 let del = &self.delassus_cache.as_ref().expect("built above").1;
                 let m = del.m;

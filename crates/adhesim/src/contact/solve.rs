@@ -18,8 +18,42 @@ pub struct Delassus {
 /// reduced to rows of W and dropped, so the memory is that of W plus DOFs × this.
 const DELASSUS_CHUNK: usize = 64;
 
-/// Builds W with the current factorisation, 64 columns of K̄⁻¹Hᵀ at a time; constrained
-/// unknowns get no contact force.
+/// Columns `start..start + cols` of W (the contact force components 3p + c) into `out`,
+/// column-major (`cols` × 3N_c), with one multi-right-hand-side solve: the columns K̄⁻¹Hᵀ go
+/// through `scratch` (DOFs × cols) and are reduced by H. Constrained unknowns get no force.
+fn w_columns(
+    points: &[ContactPoint],
+    start: usize,
+    cols: usize,
+    chol: &mut SparseCholesky,
+    constrained: &[bool],
+    scratch: &mut [f64],
+    out: &mut [f64],
+) {
+    let n = constrained.len();
+    let m = 3 * points.len();
+    let block = &mut scratch[..n * cols];
+    block.iter_mut().for_each(|v| *v = 0.0);
+    for (j, col) in block.chunks_exact_mut(n).enumerate() {
+        let (p, c) = ((start + j) / 3, (start + j) % 3);
+        let mut r = [0.0; 3];
+        r[c] = 1.0;
+        points[p].add_ht(r, col);
+        for (v, &fixed) in col.iter_mut().zip(constrained) {
+            if fixed {
+                *v = 0.0;
+            }
+        }
+    }
+    chol.solve_in_place(block);
+    for (zc, wc) in block.chunks_exact(n).zip(out.chunks_exact_mut(m)) {
+        for (pt, w3) in points.iter().zip(wc.chunks_exact_mut(3)) {
+            w3.copy_from_slice(&pt.apply_h(zc));
+        }
+    }
+}
+
+/// Builds W with the current factorisation, 64 columns of K̄⁻¹Hᵀ at a time.
 pub fn delassus(
     points: &[ContactPoint],
     chol: &mut SparseCholesky,
@@ -27,36 +61,26 @@ pub fn delassus(
 ) -> Delassus {
     let n = constrained.len();
     let m = 3 * points.len();
+    let chunk = DELASSUS_CHUNK.min(m.max(1));
+    let mut scratch = vec![0.0; n * chunk];
+    let mut cols_out = vec![0.0; m * chunk];
     let mut w = vec![0.0; m * m];
-    let mut z = vec![0.0; n * DELASSUS_CHUNK.min(m.max(1))];
-    let mut start = 0;
-    while start < m {
-        let cols = DELASSUS_CHUNK.min(m - start);
-        let block = &mut z[..n * cols];
-        block.iter_mut().for_each(|v| *v = 0.0);
-        for j in 0..cols {
-            let (p, c) = ((start + j) / 3, (start + j) % 3);
-            let col = &mut block[j * n..(j + 1) * n];
-            let mut r = [0.0; 3];
-            r[c] = 1.0;
-            points[p].add_ht(r, col);
-            for (v, &fixed) in col.iter_mut().zip(constrained) {
-                if fixed {
-                    *v = 0.0;
-                }
+    for start in (0..m).step_by(chunk) {
+        let cols = chunk.min(m - start);
+        w_columns(
+            points,
+            start,
+            cols,
+            chol,
+            constrained,
+            &mut scratch,
+            &mut cols_out,
+        );
+        for (j, wc) in cols_out.chunks_exact(m).take(cols).enumerate() {
+            for (row, &v) in wc.iter().enumerate() {
+                w[row * m + start + j] = v;
             }
         }
-        chol.solve_in_place(block);
-        for j in 0..cols {
-            let zc = &block[j * n..(j + 1) * n];
-            for (p, pt) in points.iter().enumerate() {
-                let h = pt.apply_h(zc);
-                for a in 0..3 {
-                    w[(3 * p + a) * m + start + j] = h[a];
-                }
-            }
-        }
-        start += cols;
     }
     // Symmetrise (W is symmetric in exact arithmetic).
     for i in 0..m {
@@ -69,38 +93,45 @@ pub fn delassus(
     Delassus { w, m }
 }
 
-/// The three columns of W belonging to contact point `probe`, column-major (3 × 3N_c), with
-/// the current factorisation: three solves instead of 3N_c.
-pub fn delassus_columns(
-    points: &[ContactPoint],
-    probe: usize,
-    chol: &mut SparseCholesky,
-    constrained: &[bool],
-) -> Vec<f64> {
-    let n = constrained.len();
-    let m = 3 * points.len();
-    let mut z = vec![0.0; 3 * n];
-    for c in 0..3 {
-        let col = &mut z[c * n..(c + 1) * n];
-        let mut r = [0.0; 3];
-        r[c] = 1.0;
-        points[probe].add_ht(r, col);
-        for (v, &fixed) in col.iter_mut().zip(constrained) {
-            if fixed {
-                *v = 0.0;
+impl Delassus {
+    /// Relative change ‖W_now − W‖ / ‖W_now‖ over the three columns of contact point `probe`,
+    /// with W_now from the current factorisation: three solves instead of the 3N_c of a
+    /// rebuild, to tell whether this W can still be used.
+    pub fn probed_change(
+        &self,
+        points: &[ContactPoint],
+        probe: usize,
+        chol: &mut SparseCholesky,
+        constrained: &[bool],
+    ) -> f64 {
+        let m = self.m;
+        let mut scratch = vec![0.0; 3 * constrained.len()];
+        let mut fresh = vec![0.0; 3 * m];
+        w_columns(
+            points,
+            3 * probe,
+            3,
+            chol,
+            constrained,
+            &mut scratch,
+            &mut fresh,
+        );
+        let (mut diff, mut size) = (0.0f64, 0.0f64);
+        for (c, wc) in fresh.chunks_exact(m).enumerate() {
+            for (row, &a) in wc.iter().enumerate() {
+                let b = self.w[row * m + 3 * probe + c];
+                diff += (a - b) * (a - b);
+                size += a * a;
             }
         }
-    }
-    chol.solve_in_place(&mut z);
-    let mut out = vec![0.0; 3 * m];
-    for c in 0..3 {
-        let zc = &z[c * n..(c + 1) * n];
-        for (p, pt) in points.iter().enumerate() {
-            let h = pt.apply_h(zc);
-            out[c * m + 3 * p..c * m + 3 * p + 3].copy_from_slice(&h);
+        if size > 0.0 {
+            (diff / size).sqrt()
+        } else if diff == 0.0 {
+            0.0
+        } else {
+            f64::INFINITY
         }
     }
-    out
 }
 
 /// Result of the Gauss-Seidel solve.

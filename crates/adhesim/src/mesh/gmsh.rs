@@ -20,7 +20,7 @@
 //! node orders are adhesim's (VTK) orders, so cells are taken as they are. Higher-order and
 //! other volume or surface elements are rejected.
 
-use super::{Face, Mesh, HEX_FACES, TET_FACES};
+use super::{Face, Mesh};
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -939,22 +939,7 @@ impl MshFile {
             mesh.set_nodes(name, nodes);
         }
         // Physical surfaces: boundary faces re-oriented outward from their cell.
-        let mut owners: HashMap<Vec<usize>, (usize, Face)> = HashMap::new();
-        let mut add = |f: Face| {
-            let mut key = f.nodes().to_vec();
-            key.sort_unstable();
-            owners.entry(key).and_modify(|e| e.0 += 1).or_insert((1, f));
-        };
-        for h in &mesh.hexes {
-            for f in HEX_FACES {
-                add(Face::Quad(f.map(|k| h[k])));
-            }
-        }
-        for t in &mesh.tets {
-            for f in TET_FACES {
-                add(Face::Tri(f.map(|k| t[k])));
-            }
-        }
+        let owners = mesh.cell_faces();
         let mut faces: BTreeMap<String, (Vec<Face>, Vec<usize>)> = BTreeMap::new();
         let surface = self
             .quads

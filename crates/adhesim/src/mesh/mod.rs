@@ -86,11 +86,12 @@ impl Mesh {
         }
     }
 
-    /// Node indices of every cell face that belongs to exactly one cell (the boundary),
-    /// outward oriented.
-    pub fn boundary_faces(&self) -> Vec<Face> {
-        use std::collections::HashMap;
-        let mut count: HashMap<Vec<usize>, (usize, Face)> = HashMap::new();
+    /// Every face of every cell, keyed by its sorted node indices, with the number of cells
+    /// that have it (1 on the boundary, 2 inside) and its outward orientation seen from the
+    /// first of them.
+    pub fn cell_faces(&self) -> std::collections::HashMap<Vec<usize>, (usize, Face)> {
+        let mut count: std::collections::HashMap<Vec<usize>, (usize, Face)> =
+            std::collections::HashMap::new();
         let mut add = |f: Face| {
             let mut key = f.nodes().to_vec();
             key.sort_unstable();
@@ -106,6 +107,13 @@ impl Mesh {
                 add(Face::Tri([t[f[0]], t[f[1]], t[f[2]]]));
             }
         }
+        count
+    }
+
+    /// Node indices of every cell face that belongs to exactly one cell (the boundary),
+    /// outward oriented.
+    pub fn boundary_faces(&self) -> Vec<Face> {
+        let count = self.cell_faces();
         let mut faces: Vec<Face> = count
             .into_values()
             .filter(|e| e.0 == 1)

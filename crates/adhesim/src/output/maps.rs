@@ -10,17 +10,14 @@
 
 use super::csv::read_history;
 use super::plot::{draw_scalar_map_with, ColorMap, PlotError, ScalarMap, ScalarValues};
-use super::{Observer, StepView};
+use super::{contact_node_values, Observer, StepView};
 use crate::problem::MapRequest;
-use crate::time::NodeContact;
 use std::collections::BTreeMap;
 use std::io;
 use std::path::{Path, PathBuf};
 
 /// Contact fields that can be mapped, in the order of the map CSV columns.
-pub const MAP_FIELDS: [&str; 9] = [
-    "beta", "rn", "rn_dry", "rn_adh", "rt", "rt_adh", "gap", "slip", "state",
-];
+pub use super::CONTACT_NODE_FIELDS as MAP_FIELDS;
 
 /// Colour-bar label (quantity and units) of a map field.
 fn map_label(field: &str) -> &'static str {
@@ -36,21 +33,6 @@ fn map_label(field: &str) -> &'static str {
         "state" => "0 none, 1 apart, 2 stick, 3 slide",
         _ => "",
     }
-}
-
-/// Values of the map fields at one slave node, in the order of [`MAP_FIELDS`].
-pub fn map_values(c: &NodeContact) -> [f64; 9] {
-    [
-        c.beta,
-        c.r_dry[2] + c.r_adh[2],
-        c.r_dry[2],
-        c.r_adh[2],
-        (c.r_dry[0] + c.r_adh[0]).hypot(c.r_dry[1] + c.r_adh[1]),
-        c.r_adh[0].hypot(c.r_adh[1]),
-        c.gap,
-        c.slip[0].hypot(c.slip[1]),
-        c.state as f64,
-    ]
 }
 
 /// Writes the map CSVs of the requested pairs and times.
@@ -142,7 +124,7 @@ impl Observer for MapObserver {
                 {
                     let x = view.disc.reference[n];
                     text.push_str(&format!("{i},{:e},{:e},{:e},{:e}", x[0], x[1], x[2], t));
-                    let values = map_values(c);
+                    let values = contact_node_values(c);
                     for &k in &cols {
                         text.push_str(&format!(",{:e}", values[k]));
                     }

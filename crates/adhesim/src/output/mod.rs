@@ -351,7 +351,7 @@ pub fn history_columns(problem: &Problem) -> Vec<String> {
         }
         let pairs = track_contacts(problem, tr.node);
         for &(p, _) in &pairs {
-            for f in CONTACT_TRACK_FIELDS {
+            for f in CONTACT_NODE_FIELDS {
                 if pairs.len() == 1 {
                     c.push(format!("{}.{f}", tr.name));
                 } else {
@@ -363,10 +363,28 @@ pub fn history_columns(problem: &Problem) -> Vec<String> {
     c
 }
 
-/// Contact fields written for a tracked node that is a slave node of a pair.
-const CONTACT_TRACK_FIELDS: [&str; 9] = [
+/// Contact fields of one slave node, as written for tracked nodes in the history and in the
+/// contact maps; [`contact_node_values`] gives them in this order.
+pub const CONTACT_NODE_FIELDS: [&str; 9] = [
     "beta", "rn", "rn_dry", "rn_adh", "rt", "rt_adh", "gap", "slip", "state",
 ];
+
+/// The [`CONTACT_NODE_FIELDS`] of one slave node: β, total, dry and adhesive normal force
+/// [N], norms of the total and adhesive tangential force [N], gap [m], slip of the step [m]
+/// and state code.
+pub fn contact_node_values(c: &NodeContact) -> [f64; 9] {
+    [
+        c.beta,
+        c.r_dry[2] + c.r_adh[2],
+        c.r_dry[2],
+        c.r_adh[2],
+        (c.r_dry[0] + c.r_adh[0]).hypot(c.r_dry[1] + c.r_adh[1]),
+        c.r_adh[0].hypot(c.r_adh[1]),
+        c.gap,
+        c.slip[0].hypot(c.slip[1]),
+        c.state as f64,
+    ]
+}
 
 /// (pair, index within the pair) for every pair of which a tracked node is a slave node.
 /// A node in one pair gets columns `<track>.<field>`; a node in several pairs (a wheel
@@ -451,18 +469,7 @@ impl Observer for HistoryObserver {
             row.extend_from_slice(&view.state.u[3 * n..3 * n + 3]);
             row.extend_from_slice(&view.state.v[3 * n..3 * n + 3]);
             for (p, i) in track_contacts(view.problem, n) {
-                let c = &view.contact[p][i];
-                row.extend_from_slice(&[
-                    c.beta,
-                    c.r_dry[2] + c.r_adh[2],
-                    c.r_dry[2],
-                    c.r_adh[2],
-                    (c.r_dry[0] + c.r_adh[0]).hypot(c.r_dry[1] + c.r_adh[1]),
-                    c.r_adh[0].hypot(c.r_adh[1]),
-                    c.gap,
-                    c.slip[0].hypot(c.slip[1]),
-                    c.state as f64,
-                ]);
+                row.extend_from_slice(&contact_node_values(&view.contact[p][i]));
             }
         }
         self.writer.append(&row)
