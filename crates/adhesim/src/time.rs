@@ -10,7 +10,7 @@
 use crate::assembly::{BadElement, Discretisation};
 use crate::contact::detect::{detect, ContactPoint};
 use crate::contact::law::{BondState, ContactState, PointSolution};
-use crate::contact::newton::{self, augmented_point, updated_multiplier, AugmentedPoint};
+use crate::contact::newton::{self, augmented_point, bipotential_projection, AugmentedPoint};
 use crate::contact::solve::{delassus, gauss_seidel, Delassus};
 use crate::linalg::LinalgError;
 use crate::problem::{ContactSolver, Problem};
@@ -587,6 +587,17 @@ impl Stepper {
             )
         };
         let bond0 = self.bonds_at_start(&points);
+        // Force the adhesive bonds of the candidates can carry, ‖(A_α √(C w))_α‖ [N]: the force
+        // scale of an interface that holds (or snaps into) contact without load.
+        let bond_strength = points
+            .iter()
+            .map(|pt| {
+                let law = &self.problem.contacts[pt.pair].law;
+                law.adhesion
+                    .map_or(0.0, |a| (pt.area * a.peak_traction()).powi(2))
+            })
+            .sum::<f64>()
+            .sqrt();
         let laws: Vec<_> = self.problem.contacts.iter().map(|c| c.law).collect();
         let mut r_contact: Vec<[f64; 3]> = vec![[0.0; 3]; points.len()];
         let mut r_dry: Vec<[f64; 3]> = vec![[0.0; 3]; points.len()];
@@ -642,6 +653,7 @@ impl Stepper {
         let mut last_correction_negligible = false;
         let mut last_rel = f64::NAN;
         let mut line_search: Option<LineSearch> = None;
+        let mut contact_energy = 0.0;
         let mut prev_du_norm: Option<f64> = None;
         let mut delassus_builds = 0usize;
         // Whether this attempt has built or checked the Delassus operator in use.
@@ -669,6 +681,12 @@ impl Stepper {
                 g[i] = c_stiff * (asm.force[i] - f_ext1[i]) - fixed[i];
             }
             let mut scale = norm(&asm.force).max(norm(&f_ext1)).max(norm(&fixed));
+            // The step's potential Π(u), whose gradient is g (for the line search): strain
+            // energy, loads, and the inertia and damping terms of the θ-method.
+            let mut potential = c_stiff * asm.energy
+                - (0..n)
+                    .map(|i| (c_stiff * f_ext1[i] + fixed[i]) * u[i])
+                    .sum::<f64>();
             if !qs {
                 tmp.iter_mut().for_each(|x| *x = 0.0);
                 let acc: Vec<f64> = (0..n)
@@ -680,6 +698,7 @@ impl Stepper {
                 scale = scale.max(norm(&tmp));
                 for i in 0..n {
                     g[i] += tmp[i];
+                    potential += 0.5 * (u[i] - u0[i] - dt * v0[i]) * tmp[i];
                 }
                 if let Some(a) = &self.damping {
                     tmp.iter_mut().for_each(|x| *x = 0.0);
@@ -687,9 +706,19 @@ impl Stepper {
                     for i in 0..n {
                         g[i] += xi * tmp[i];
                     }
+                    // ξ A v₁ is the gradient of ξ[(u − u₀)ᵀA(u − u₀)/(2θΔt) − (1−θ)/θ v₀ᵀA(u − u₀)].
+                    let half: Vec<f64> = (0..n)
+                        .map(|i| {
+                            0.5 * (u[i] - u0[i]) / (theta * dt) - (1.0 - theta) / theta * v0[i]
+                        })
+                        .collect();
+                    tmp.iter_mut().for_each(|x| *x = 0.0);
+                    self.disc.pattern.symmetric_matvec(a, &half, &mut tmp);
+                    potential += xi * (0..n).map(|i| (u[i] - u0[i]) * tmp[i]).sum::<f64>();
                 }
             }
             let mut contact_defect = 0.0;
+            let mut natural_map = 0.0;
             if iter == 1 && !points.is_empty() {
                 rho = self.augmentation(&points, &asm.tangent, c_stiff, c_mass, c_damp);
             }
@@ -699,17 +728,23 @@ impl Stepper {
                 (evals, contact_force) =
                     self.contact_law_at(&points, &laws, &bond0, dt, &rho, &lambda, &u);
                 let merit = norm_free(&g, &contact_force, &self.constrained);
-                // Line search on that step: within one set of contact cases (open, stick,
-                // slide at every point) the Newton step must reduce ‖G(u) − Hᵀr(u)‖, else it
-                // is halved. A step that changes the cases is taken whole (an active-set
-                // step), unless the iteration count says the cases are cycling.
+                let total: f64 = potential + evals.iter().map(|e| e.energy).sum::<f64>();
+                // Line search on that step: with the multipliers fixed, the Newton step
+                // solves for a stationary point of Π(u) + Σ φ_α(x_α(u)), and its matrix is
+                // positive definite, so the step is a descent direction. A step that does not
+                // lower that potential by the Armijo factor is halved (a full step can
+                // overshoot where points open or close, and then cycle).
                 if let Some(ls) = &mut line_search {
                     let same_cases = evals
                         .iter()
                         .zip(&ls.cases)
                         .all(|(e, c)| e.solution.state == *c);
+                    // Near the solution the potential's decrease drowns in its round-off:
+                    // a step that reduces ‖G − Hᵀr‖ is accepted as well.
+                    let descent = total <= ls.energy0 + 1e-4 * ls.alpha * ls.slope
+                        || merit <= (1.0 - 1e-4 * ls.alpha) * ls.merit0;
                     if (same_cases || iter > CYCLING_ITERATIONS)
-                        && merit > (1.0 - 1e-4 * ls.alpha) * ls.merit0
+                        && !descent
                         && ls.alpha > MIN_STEP_LENGTH
                     {
                         ls.alpha *= 0.5;
@@ -720,19 +755,23 @@ impl Stepper {
                         continue;
                     }
                 }
+                line_search = None;
+                contact_energy = total;
                 contact_defect = newton::defect_norm(&evals);
                 // Multiplier update λ ← P_K(λ − ρ x̂(u)) once the equilibrium with the current
                 // multipliers is reached to a tenth of the change the update would make.
                 if iter > 1 && merit <= 0.1 * contact_defect {
-                    for (p, pt) in points.iter().enumerate() {
-                        let x = pt.local_x(&self.disc.reference, &u);
-                        lambda[p] = updated_multiplier(laws[pt.pair].mu, rho[p], lambda[p], x);
+                    for (l, e) in lambda.iter_mut().zip(&evals) {
+                        *l = e.solution.r_dry;
                     }
                     sweeps += 1;
                     (evals, contact_force) =
                         self.contact_law_at(&points, &laws, &bond0, dt, &rho, &lambda, &u);
                     contact_defect = newton::defect_norm(&evals);
+                    contact_energy = potential + evals.iter().map(|e| e.energy).sum::<f64>();
                 }
+                let solved: Vec<PointSolution> = evals.iter().map(|e| e.solution).collect();
+                natural_map = natural_map_residual(&laws, &points, &rho, &solved);
                 timings.contact_solve += clock.elapsed().as_secs_f64();
             }
             // g is G(u) without contact (what the Newton correction solves against); the
@@ -747,7 +786,7 @@ impl Stepper {
                     g_check[i] = 0.0;
                 }
             }
-            scale = scale.max(norm(&contact_force));
+            scale = scale.max(norm(&contact_force)).max(bond_strength);
             let gnorm = norm(&g_check);
             if !gnorm.is_finite() {
                 return Err(format!(
@@ -760,15 +799,8 @@ impl Stepper {
             let scale = scale.max(norm(&reactions)).max(f64::MIN_POSITIVE);
             let rel = gnorm / scale;
             last_rel = rel;
-            if std::env::var_os("ADHESIM_DEBUG").is_some() {
-                let states: Vec<i32> = evals
-                    .iter()
-                    .map(|e| e.solution.state as i32 * 10 + (e.solution.beta > 0.0) as i32)
-                    .collect();
-                eprintln!("t={:.9} dt={dt:.3e} iter={iter} rel={rel:.3e} contact={:.3e} upd={sweeps} {:?}", self.state.t, contact_defect/scale, states);
-            }
             if newton_contact {
-                contact_residual = contact_defect / scale;
+                contact_residual = natural_map / scale;
             }
             // Converged when the residual is small against the forces, or when the last
             // correction was negligible against the step's displacement increment (the
@@ -926,15 +958,20 @@ impl Stepper {
                 }
                 contact_force = new_force;
                 solutions = sol.points;
-                contact_residual = gauss_seidel_residual(&laws, &points, &rho, &solutions) / scale;
+                contact_residual = natural_map_residual(&laws, &points, &rho, &solutions) / scale;
                 timings.delassus += clock.elapsed().as_secs_f64();
             }
             if newton_contact && !points.is_empty() {
                 line_search = Some(LineSearch {
                     cases: evals.iter().map(|e| e.solution.state).collect(),
+                    slope: (0..n)
+                        .filter(|&i| !self.constrained[i])
+                        .map(|i| (g[i] - contact_force[i]) * du[i])
+                        .sum(),
                     u0: u.clone(),
                     du: du.clone(),
                     alpha: 1.0,
+                    energy0: contact_energy,
                     merit0: gnorm,
                 });
             }
@@ -1014,9 +1051,10 @@ impl Stepper {
     }
 }
 
-/// Natural-map residual ‖(r̄_α − P_K(r̄_α − ρ_α x̂_α))_α‖ [N] of a Gauss-Seidel solution at its
-/// own x, with the ρ_α of the Newton solver, so that both solvers report the same measure.
-fn gauss_seidel_residual(
+/// Natural-map residual ‖(r̄_α − P_K(r̄_α − ρ_α x̂_α))_α‖ [N] of the bi-potential condition,
+/// at each solution's own x, with the ρ_α of the Newton solver: the same measure for both
+/// solvers.
+fn natural_map_residual(
     laws: &[crate::contact::InterfaceLaw],
     points: &[ContactPoint],
     rho: &[f64],
@@ -1027,7 +1065,7 @@ fn gauss_seidel_residual(
         .zip(rho)
         .zip(solutions)
         .map(|((pt, &rho), sol)| {
-            let p = updated_multiplier(laws[pt.pair].mu, rho, sol.r_dry, sol.x);
+            let p = bipotential_projection(laws[pt.pair].mu, rho, sol.r_dry, sol.x);
             (0..3).map(|k| (sol.r_dry[k] - p[k]).powi(2)).sum::<f64>()
         })
         .sum::<f64>()
@@ -1035,17 +1073,19 @@ fn gauss_seidel_residual(
 }
 
 /// A Newton step under line search: from `u0` along `du`, at step length `alpha`, against the
-/// residual norm `merit0` at `u0`.
+/// potential `energy0` at `u0` and its slope along `du`.
 struct LineSearch {
     cases: Vec<ContactState>,
     u0: Vec<f64>,
     du: Vec<f64>,
     alpha: f64,
+    energy0: f64,
+    slope: f64,
     merit0: f64,
 }
 
 /// Newton iterations after which a step that changes the contact cases is line-searched too.
-const CYCLING_ITERATIONS: usize = 8;
+const CYCLING_ITERATIONS: usize = 0;
 
 /// Shortest step length the line search tries before it takes the step anyway.
 const MIN_STEP_LENGTH: f64 = 1.0 / 64.0;

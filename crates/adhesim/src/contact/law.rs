@@ -788,6 +788,8 @@ pub struct AdhesiveResponse {
     /// −∂r̃/∂x with β₁ held fixed [N/m]: A β₁² diag(C_t, C_t, C_n [x_n > 0]), symmetric
     /// positive semi-definite (the softening part from ∂β₁/∂x is left out).
     pub secant_stiffness: [[f64; 3]; 3],
+    /// Incremental potential of the bond φ [J], with ∂φ/∂x = −r̃.
+    pub energy: f64,
 }
 
 /// [`AdhesiveResponse`] of the law `a` at `x` [m].
@@ -811,6 +813,7 @@ pub fn adhesive_response(
         ut: if ev.beta > 0.0 { ev.ut } else { [0.0; 2] },
         force: ev.force,
         secant_stiffness,
+        energy: ev.energy,
     }
 }
 
