@@ -717,7 +717,6 @@ impl Stepper {
                     potential += xi * (0..n).map(|i| (u[i] - u0[i]) * tmp[i]).sum::<f64>();
                 }
             }
-            let mut contact_defect = 0.0;
             let mut natural_map = 0.0;
             if iter == 1 && !points.is_empty() {
                 rho = self.augmentation(&points, &asm.tangent, c_stiff, c_mass, c_damp);
@@ -757,7 +756,7 @@ impl Stepper {
                 }
                 line_search = None;
                 contact_energy = total;
-                contact_defect = newton::defect_norm(&evals);
+                let contact_defect = newton::defect_norm(&evals);
                 // Multiplier update λ ← P_K(λ − ρ x̂(u)) once the equilibrium with the current
                 // multipliers is reached to a tenth of the change the update would make.
                 if iter > 1 && merit <= 0.1 * contact_defect {
@@ -767,7 +766,6 @@ impl Stepper {
                     sweeps += 1;
                     (evals, contact_force) =
                         self.contact_law_at(&points, &laws, &bond0, dt, &rho, &lambda, &u);
-                    contact_defect = newton::defect_norm(&evals);
                     contact_energy = potential + evals.iter().map(|e| e.energy).sum::<f64>();
                 }
                 let solved: Vec<PointSolution> = evals.iter().map(|e| e.solution).collect();
