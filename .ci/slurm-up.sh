@@ -16,20 +16,22 @@ if ! command -v sbatch >/dev/null 2>&1 || ! command -v munged >/dev/null 2>&1; t
   apt-get update -qq
   DEBIAN_FRONTEND=noninteractive apt-get install -y -qq slurm-wlm munge >/dev/null
 fi
-if sinfo -h -o '%T' 2>/dev/null | grep -Eq '^(idle|mixed|allocated)'; then
+# sinfo retries for a minute when no controller answers: a few seconds are enough here.
+node_up() { timeout 5 sinfo -h -o '%T' 2>/dev/null | grep -Eq '^(idle|mixed|allocated)'; }
+if node_up; then
   echo "slurm-up: a cluster is already running"
   exit 0
 fi
 
 mkdir -p "$state"/spool/ctld "$state"/spool/d "$state"/log /run/munge /var/lib/munge /var/log/munge
 # munge: a new key, the default socket (which Slurm's auth/munge uses).
-if ! pgrep -x munged >/dev/null; then
+if ! munge -n </dev/null >/dev/null 2>&1; then
   dd if=/dev/urandom of="$state/munge.key" bs=1024 count=1 status=none
   chmod 400 "$state/munge.key"
-  munged --force --key-file="$state/munge.key"
+  munged --force --key-file="$state/munge.key" 2>/dev/null
 fi
 
-host=$(hostname -s)
+host=$(uname -n)
 node=$(slurmd -C | head -n 1)   # NodeName=<host> CPUs=... RealMemory=...
 conf="$state/slurm.conf"
 cat >"$conf" <<CONF
@@ -72,7 +74,7 @@ export SLURM_CONF=$conf
 slurmctld -c -f "$conf"
 slurmd -f "$conf"
 for _ in $(seq 60); do
-  if sinfo -h -o '%T' 2>/dev/null | grep -Eq '^(idle|mixed|allocated)'; then
+  if node_up; then
     sinfo
     exit 0
   fi
