@@ -252,6 +252,54 @@ mod tests {
         assert_eq!(array_spec(&[4]), "4");
     }
 
+    fn plan() -> SweepPlan {
+        let axes = vec![
+            crate::sweep::Axis::parse("contact.top.friction=0,0.2").unwrap(),
+            crate::sweep::Axis::parse("body.0.mesh.divisions=[4,2,1],[8,4,1]").unwrap(),
+        ];
+        let fixed = vec!["time.t_end=1.0".to_string()];
+        SweepPlan::new(Path::new("/s/x.toml"), Some("coarse".into()), &fixed, &axes).unwrap()
+    }
+
+    #[test]
+    fn the_script_has_one_branch_per_case_and_the_asked_sbatch_lines() {
+        let options = SlurmOptions {
+            partition: Some("short".into()),
+            mem: Some("2G".into()),
+            cpus_per_task: 4,
+            extra: vec!["--qos=long".into()],
+            checkpoint_every: 7,
+            ..Default::default()
+        };
+        let text = script(
+            &plan(),
+            Path::new("/d/sw"),
+            Path::new("/bin/adhesim"),
+            &options,
+        )
+        .unwrap();
+        for line in [
+            "#SBATCH --array=1-4",
+            "#SBATCH --partition=short",
+            "#SBATCH --mem=2G",
+            "#SBATCH --cpus-per-task=4",
+            "#SBATCH --qos=long",
+            "--checkpoint-every 7",
+        ] {
+            assert!(text.contains(line), "{line} missing from\n{text}");
+        }
+        assert!(!text.contains("--time="), "no --time line unless asked");
+        let case4 = "  4) out=case04_friction=0.2_divisions=-8-4-1-; set -- --variant coarse \
+                     --set time.t_end=1.0 --set contact.top.friction=0.2 \
+                     --set 'body.0.mesh.divisions=[8,4,1]' ;;";
+        assert!(text.contains(case4), "{case4} missing from\n{text}");
+        let bad = SlurmOptions {
+            extra: vec!["--qos=a\n#SBATCH --x".into()],
+            ..Default::default()
+        };
+        assert!(script(&plan(), Path::new("/d"), Path::new("/a"), &bad).is_err());
+    }
+
     #[test]
     fn shell_quoting_survives_quotes_and_spaces() {
         assert_eq!(shell_quote("time.dt=1e-4"), "time.dt=1e-4");

@@ -473,6 +473,8 @@ pub fn run_sweep(
         .into_iter()
         .map(|p| Mutex::new(Some(p)))
         .collect();
+    // One sweep at a time in a folder (each case also locks its own).
+    let _lock = crate::outdir::lock(out_dir).map_err(|e| SweepError::Folder(e.to_string()))?;
     check_folder(plan, out_dir, options.resume, options.overwrite)?;
     plan.write(out_dir)?;
     let cases = plan.parsed_cases();
@@ -808,6 +810,46 @@ mod tests {
         assert_eq!(c[3].label, "friction=0.2, v=1.0");
         assert_eq!(c[5].dir_name, "case06_friction=0.2_v=0.6");
         assert_eq!(c[4].overrides[1].value, toml::Value::Float(0.8));
+    }
+
+    #[test]
+    fn a_plan_survives_its_json_and_gives_each_case_its_run_arguments() {
+        let axes = vec![
+            Axis::parse("contact.top.friction=0,0.2").unwrap(),
+            Axis::parse("v=1.0,0.8,0.6").unwrap(),
+        ];
+        let plan = SweepPlan::new(
+            Path::new("/s/x.toml"),
+            None,
+            &["time.dt=1e-4".to_string()],
+            &axes,
+        )
+        .unwrap();
+        assert_eq!(plan.cases.len(), 6);
+        assert_eq!(plan.cases[4].number, 5);
+        assert_eq!(plan.cases[4].dir, "case05_friction=0.2_v=0.8");
+        assert_eq!(
+            plan.run_args(&plan.cases[4]),
+            [
+                "--set",
+                "time.dt=1e-4",
+                "--set",
+                "contact.top.friction=0.2",
+                "--set",
+                "v=0.8"
+            ]
+        );
+        let back: SweepPlan = serde_json::from_slice(&serde_json::to_vec(&plan).unwrap()).unwrap();
+        assert_eq!(back, plan);
+        assert_eq!(
+            back.parsed_cases()
+                .iter()
+                .map(|c| c.dir_name.clone())
+                .collect::<Vec<_>>(),
+            plan.cases.iter().map(|c| c.dir.clone()).collect::<Vec<_>>()
+        );
+        let other = SweepPlan::new(Path::new("/s/x.toml"), None, &[], &axes).unwrap();
+        assert!(!plan.same_study(&other), "the fixed overrides differ");
     }
 
     #[test]
