@@ -315,7 +315,7 @@ impl SweepPlan {
     /// Reads `dir/sweep.json`.
     pub fn read(dir: &Path) -> Result<SweepPlan, SweepError> {
         let path = dir.join(PLAN_FILE);
-        let bytes = std::fs::read(&path).map_err(|source| SweepError::Io {
+        let bytes = std::fs::read(&path).map_err(|source| SweepError::Read {
             path: path.clone(),
             source,
         })?;
@@ -379,6 +379,14 @@ pub enum SweepError {
     #[error("cannot write {path}: {source}")]
     Io {
         /// The file or folder.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// A sweep folder's plan cannot be read.
+    #[error("cannot read {path} (is this a sweep folder? `adhesim sweep` writes it): {source}")]
+    Read {
+        /// The plan file.
         path: PathBuf,
         /// The I/O error.
         source: std::io::Error,
