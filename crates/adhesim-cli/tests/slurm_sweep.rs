@@ -149,9 +149,10 @@ fn a_job_array_sweep_with_a_cancelled_task_collects_to_the_local_table() {
         return;
     }
     let _ = std::fs::remove_dir_all(work_dir());
-    // The local sweep, two cases at a time (one thread each, as each array task has).
+    // The local sweep, one case per core: one thread each, as each array task has.
     let local = work_dir().join("local");
-    let o = sweep(&local, &["-j", "2"]).output().unwrap();
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let o = sweep(&local, &["-j", &cores.to_string()]).output().unwrap();
     assert!(o.status.success(), "local sweep: {o:?}");
 
     let array = work_dir().join("array");
