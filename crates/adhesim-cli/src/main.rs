@@ -26,6 +26,7 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
+#[allow(clippy::large_enum_variant)] // parsed once; boxing would only obscure the fields
 enum Command {
     /// Run a scenario and write its outputs.
     ///
@@ -34,6 +35,10 @@ enum Command {
     /// Ctrl-C stops at once); `adhesim run FILE --resume DIR` continues from it and gives the
     /// outputs of an uninterrupted run. DIR/run.json says `running`, `finished`,
     /// `interrupted` or `failed`.
+    ///
+    /// A run locks its output directory (DIR/run.lock): a second run into it is refused
+    /// with the first one's process id. A directory that holds a previous run is refused
+    /// unless --resume or --overwrite is given.
     ///
     /// Exit codes: 0 the run reached its end time, 1 it stopped early (Δt fell below its
     /// minimum; everything computed until then is kept), 2 the scenario is invalid, the
@@ -52,6 +57,10 @@ enum Command {
         /// (the scenario must be unchanged).
         #[arg(long, value_name = "DIR")]
         resume: Option<PathBuf>,
+        /// Replace the run whose outputs are in the output directory (finished, interrupted
+        /// or killed); without it such a directory is refused, so that no run is lost.
+        #[arg(long, conflicts_with = "resume")]
+        overwrite: bool,
         /// Print nothing but errors.
         #[arg(long, short)]
         quiet: bool,
@@ -67,15 +76,29 @@ enum Command {
     /// Run a parameter study: the cartesian product of the values given with --set, one case
     /// per worker at a time, each in its own sub-folder of the output directory; then one
     /// comparison figure per tracked quantity (one curve per case) in DIR/figures/ and a
-    /// summary table DIR/sweep.csv.
+    /// summary table DIR/sweep.csv. DIR/sweep.json holds the plan.
     ///
     /// Example: adhesim sweep scenarios/paper/plate-on-cylinder.toml
     ///   --set v_descent=1.0,0.8,0.6,0.4,0.2 --set contact.plate.friction=0,0.2,0.4,0.6,0.8
     ///
-    /// Exit codes: 0 every case finished, 1 some case stopped early, 2 invalid input.
+    /// Ctrl-C stops every running case after its step with a checkpoint; the same command
+    /// with --resume keeps the finished cases, resumes the interrupted ones and runs the rest.
+    ///
+    /// On a Slurm cluster: --slurm writes the plan and a job-array script
+    /// (DIR/slurm/sweep.sbatch, one array task per case) instead of running, --submit also
+    /// submits it; `adhesim sweep submit DIR` (re)submits the unfinished cases and
+    /// `adhesim sweep collect DIR` assembles sweep.csv and the figures from whatever cases
+    /// have finished.
+    ///
+    /// Exit codes: 0 every case finished, 1 some case stopped early, 2 invalid input or an
+    /// output directory that holds another sweep, 130 interrupted by Ctrl-C or SIGTERM.
+    #[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
     Sweep {
+        #[command(subcommand)]
+        action: Option<SweepAction>,
         /// Scenario file (TOML).
-        scenario: PathBuf,
+        #[arg(required = true)]
+        scenario: Option<PathBuf>,
         /// A swept key and its values, comma-separated: KEY=V1,V2,... Repeatable; the cases
         /// are the cartesian product.
         #[arg(long = "set", value_name = "KEY=V1,V2,...", required = true)]
@@ -92,9 +115,21 @@ enum Command {
         /// Output directory [default: out/<scenario name>-sweep].
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Each case writes a checkpoint every N committed steps (0: only when stopped).
+        #[arg(long, value_name = "N", default_value_t = 100)]
+        checkpoint_every: usize,
+        /// Continue the sweep in the output directory (same scenario, --variant, --fix and
+        /// --set): finished cases are kept, interrupted ones resume from their checkpoints.
+        #[arg(long, conflicts_with = "overwrite")]
+        resume: bool,
+        /// Replace a sweep already in the output directory.
+        #[arg(long)]
+        overwrite: bool,
         /// Print nothing but errors.
         #[arg(long, short)]
         quiet: bool,
+        #[command(flatten)]
+        slurm: SlurmArgs,
     },
     /// Draw figures (PNG) from a finished run's history.csv into DIR/figures/: one per
     /// tracked quantity (displacements, β, contact and adhesive forces) with one curve per
@@ -117,6 +152,66 @@ enum Command {
     },
 }
 
+/// What `adhesim sweep` does besides running a study.
+#[derive(Subcommand)]
+enum SweepAction {
+    /// Assemble DIR/sweep.csv and the comparison figures from whatever cases of the sweep in
+    /// DIR have run, and list the cases that are missing, still running (or killed),
+    /// interrupted or failed. Exit code 0 when every case finished, 1 otherwise.
+    Collect {
+        /// Sweep directory (holds sweep.json).
+        dir: PathBuf,
+        /// Print nothing but errors and the cases that have not finished.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Submit the sweep's job-array script (written by --slurm) with sbatch: by default
+    /// every case that has not finished (a stopped case resumes from its checkpoint).
+    Submit {
+        /// Sweep directory (holds sweep.json and slurm/sweep.sbatch).
+        dir: PathBuf,
+        /// Only these case numbers (comma-separated, e.g. 2,5).
+        #[arg(long, value_name = "N,N,...", value_delimiter = ',')]
+        cases: Vec<usize>,
+    },
+}
+
+/// The job-array settings of `adhesim sweep --slurm`.
+#[derive(clap::Args)]
+struct SlurmArgs {
+    /// Write the plan and a Slurm job-array script (DIR/slurm/sweep.sbatch) instead of
+    /// running the cases here.
+    #[arg(long)]
+    slurm: bool,
+    /// Submit the script with sbatch (with --slurm).
+    #[arg(long, requires = "slurm")]
+    submit: bool,
+    /// #SBATCH --partition.
+    #[arg(long, requires = "slurm")]
+    partition: Option<String>,
+    /// #SBATCH --time: the limit of each case (e.g. 12:00:00).
+    #[arg(long, requires = "slurm")]
+    time: Option<String>,
+    /// #SBATCH --mem: the memory of each case (e.g. 8G).
+    #[arg(long, requires = "slurm")]
+    mem: Option<String>,
+    /// #SBATCH --cpus-per-task: the cores (threads) of each case.
+    #[arg(long, default_value_t = 1)]
+    cpus_per_task: usize,
+    /// #SBATCH --account.
+    #[arg(long, requires = "slurm")]
+    account: Option<String>,
+    /// Any other sbatch option, one #SBATCH line each (e.g. --sbatch=--qos=long).
+    /// Repeatable.
+    #[arg(
+        long = "sbatch",
+        value_name = "OPTION",
+        requires = "slurm",
+        allow_hyphen_values = true
+    )]
+    sbatch: Vec<String>,
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
@@ -125,11 +220,20 @@ fn main() -> ExitCode {
             out,
             checkpoint_every,
             resume,
+            overwrite,
             quiet,
             variant,
             overrides,
         } => match load_options(variant, &overrides) {
-            Ok(opts) => run(&scenario, &opts, out, checkpoint_every, resume, quiet),
+            Ok(opts) => run(
+                &scenario,
+                &opts,
+                out,
+                checkpoint_every,
+                resume,
+                overwrite,
+                quiet,
+            ),
             Err(e) => fail_input(e),
         },
         Command::Check {
@@ -141,14 +245,44 @@ fn main() -> ExitCode {
             Err(e) => fail_input(e),
         },
         Command::Sweep {
+            action: Some(SweepAction::Collect { dir, quiet }),
+            ..
+        } => collect(&dir, quiet),
+        Command::Sweep {
+            action: Some(SweepAction::Submit { dir, cases }),
+            ..
+        } => submit(&dir, &cases),
+        Command::Sweep {
+            action: None,
             scenario,
             axes,
             fixed,
             variant,
             jobs,
             out,
+            checkpoint_every,
+            resume,
+            overwrite,
             quiet,
-        } => sweep(&scenario, &axes, &fixed, variant, jobs, out, quiet),
+            slurm,
+        } => {
+            let Some(scenario) = scenario else {
+                return fail_input("adhesim sweep needs a scenario file");
+            };
+            let request = SweepRequest {
+                axes,
+                fixed,
+                variant,
+                jobs,
+                out,
+                checkpoint_every,
+                resume,
+                overwrite,
+                quiet,
+                slurm,
+            };
+            sweep(&scenario, request)
+        }
         Command::Plot { dir } => match adhesim::run::draw_figures(&dir) {
             Ok(files) => {
                 for f in files {
@@ -218,6 +352,7 @@ fn run(
     out: Option<PathBuf>,
     checkpoint_every: usize,
     resume: Option<PathBuf>,
+    overwrite: bool,
     quiet: bool,
 ) -> ExitCode {
     let problem = match adhesim::scenario::load_with(path, opts) {
@@ -236,6 +371,7 @@ fn run(
         resume: resume.is_some(),
         stop: Some(stop_on_signals()),
         stop_after_steps: None,
+        refuse_existing_run: !overwrite,
     };
     let mut progress: Box<dyn Progress> = if quiet {
         Box::new(adhesim::run::Silent)
@@ -455,20 +591,26 @@ impl adhesim::sweep::SweepProgress for SweepLines {
     }
 }
 
-fn sweep(
-    path: &Path,
-    axes: &[String],
-    fixed: &[String],
+/// `adhesim sweep FILE …` as given on the command line.
+struct SweepRequest {
+    axes: Vec<String>,
+    fixed: Vec<String>,
     variant: Option<String>,
     jobs: Option<usize>,
     out: Option<PathBuf>,
+    checkpoint_every: usize,
+    resume: bool,
+    overwrite: bool,
     quiet: bool,
-) -> ExitCode {
-    let base = match load_options(variant, fixed) {
-        Ok(o) => o,
-        Err(e) => return fail_input(e.replace("--set", "--fix")),
-    };
-    let axes = match axes
+    slurm: SlurmArgs,
+}
+
+fn sweep(path: &Path, r: SweepRequest) -> ExitCode {
+    if let Err(e) = load_options(None, &r.fixed) {
+        return fail_input(e.replace("--set", "--fix"));
+    }
+    let axes = match r
+        .axes
         .iter()
         .map(|a| adhesim::sweep::Axis::parse(a))
         .collect::<Result<Vec<_>, _>>()
@@ -476,34 +618,59 @@ fn sweep(
         Ok(a) => a,
         Err(e) => return fail_input(format!("--set: {e}")),
     };
+    let plan = match adhesim::sweep::SweepPlan::new(path, r.variant.clone(), &r.fixed, &axes) {
+        Ok(p) => p,
+        Err(e) => return fail_input(format!("{}: {e}", path.display())),
+    };
+    // The name of the default folder; every case is validated in full below.
+    let base = match load_options(r.variant.clone(), &r.fixed) {
+        Ok(o) => o,
+        Err(e) => return fail_input(e.replace("--set", "--fix")),
+    };
     let problem = match adhesim::scenario::load_with(path, &base) {
         Ok(p) => p,
         Err(e) => return fail_input(e),
     };
-    let out = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-sweep", problem.name)));
+    let out = r
+        .out
+        .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-sweep", problem.name)));
+    let n_cases = plan.cases.len();
+    if r.slurm.slurm {
+        return slurm_sweep(
+            &plan,
+            &out,
+            r.checkpoint_every,
+            r.resume,
+            r.overwrite,
+            r.slurm,
+        );
+    }
     let cores = std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1);
-    let jobs = jobs.unwrap_or(cores).max(1);
+    let jobs = r.jobs.unwrap_or(cores).max(1);
     let options = adhesim::sweep::SweepOptions {
-        base,
         jobs,
         threads_per_case: (cores / jobs).max(1),
+        checkpoint_every: r.checkpoint_every,
+        resume: r.resume,
+        overwrite: r.overwrite,
+        stop: Some(stop_on_signals()),
     };
-    let n_cases: usize = axes.iter().map(|a| a.values.len()).product();
-    if !quiet {
+    if !r.quiet {
         eprintln!(
-            "sweep of {} → {}: {n_cases} cases, {} at a time",
+            "sweep of {} → {}: {n_cases} cases, {} at a time{}",
             path.display(),
             out.display(),
-            jobs.min(n_cases.max(1))
+            jobs.min(n_cases.max(1)),
+            if r.resume { " (resumed)" } else { "" }
         );
     }
     let progress = SweepLines {
-        quiet,
+        quiet: r.quiet,
         start: Instant::now(),
     };
-    let summary = match adhesim::sweep::run_sweep(path, &axes, &options, &out, &progress) {
+    let summary = match adhesim::sweep::run_sweep(&plan, &options, &out, &progress) {
         Ok(s) => s,
         Err(e) => return fail_input(format!("{}: {e}", path.display())),
     };
@@ -512,9 +679,21 @@ fn sweep(
         .iter()
         .filter(|r| !matches!(r, Ok(s) if s.outcome == Outcome::Finished))
         .count();
-    if !quiet {
+    if summary.interrupted {
         eprintln!(
-            "done: {} cases ({failed} stopped early) in {:.1} s; summary {}, {} comparison figures in {}",
+            "sweep interrupted; every running case wrote a checkpoint.\nContinue with the same command and --resume (--out {})",
+            out.display()
+        );
+        return ExitCode::from(130);
+    }
+    if !r.quiet {
+        let kept = if summary.kept > 0 {
+            format!(", {} kept from before", summary.kept)
+        } else {
+            String::new()
+        };
+        eprintln!(
+            "done: {} cases ({failed} stopped early{kept}) in {:.1} s; summary {}, {} comparison figures in {}",
             summary.cases.len(),
             summary.wall_time,
             out.join("sweep.csv").display(),
@@ -523,6 +702,155 @@ fn sweep(
         );
     }
     if failed > 0 {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+/// `adhesim sweep … --slurm`: validates every case, writes the plan and the job-array
+/// script, and submits it with --submit.
+fn slurm_sweep(
+    plan: &adhesim::sweep::SweepPlan,
+    out: &Path,
+    checkpoint_every: usize,
+    resume: bool,
+    overwrite: bool,
+    args: SlurmArgs,
+) -> ExitCode {
+    let file = plan.scenario.display().to_string();
+    if let Err(e) = plan.load_cases() {
+        return fail_input(format!("{file}: {e}"));
+    }
+    if let Err(e) = adhesim::sweep::check_folder(plan, out, resume, overwrite) {
+        return fail_input(e);
+    }
+    let (dir, exe) = match (std::path::absolute(out), std::env::current_exe()) {
+        (Ok(d), Ok(e)) => (d, e),
+        (Err(e), _) | (_, Err(e)) => return fail_input(format!("{}: {e}", out.display())),
+    };
+    let options = adhesim::slurm::SlurmOptions {
+        partition: args.partition,
+        time: args.time,
+        mem: args.mem,
+        cpus_per_task: args.cpus_per_task,
+        account: args.account,
+        extra: args.sbatch,
+        checkpoint_every,
+    };
+    if let Err(e) = plan.write(&dir) {
+        return fail_input(e);
+    }
+    let script = match adhesim::slurm::write_script(plan, &dir, &exe, &options) {
+        Ok(s) => s,
+        Err(e) => return fail_input(e),
+    };
+    eprintln!(
+        "{} cases: plan {}, job-array script {}",
+        plan.cases.len(),
+        dir.join(adhesim::sweep::PLAN_FILE).display(),
+        script.display()
+    );
+    if !args.submit {
+        eprintln!(
+            "submit with: adhesim sweep submit {}\nthen: adhesim sweep collect {}",
+            dir.display(),
+            dir.display()
+        );
+        return ExitCode::SUCCESS;
+    }
+    submit(&dir, &[])
+}
+
+/// `adhesim sweep submit DIR`: submits the given cases, or every unfinished one.
+fn submit(dir: &Path, cases: &[usize]) -> ExitCode {
+    let plan = match adhesim::sweep::SweepPlan::read(dir) {
+        Ok(p) => p,
+        Err(e) => return fail_input(e),
+    };
+    let numbers: Vec<usize> = if cases.is_empty() {
+        plan.cases
+            .iter()
+            .filter(|c| {
+                !matches!(adhesim::sweep::read_run(&dir.join(&c.dir)),
+                    Some(s) if s.outcome == Outcome::Finished)
+            })
+            .map(|c| c.number)
+            .collect()
+    } else {
+        if let Some(bad) = cases.iter().find(|&&n| n == 0 || n > plan.cases.len()) {
+            return fail_input(format!(
+                "--cases: {bad} is not a case of the sweep in {} (1 to {})",
+                dir.display(),
+                plan.cases.len()
+            ));
+        }
+        cases.to_vec()
+    };
+    if numbers.is_empty() {
+        eprintln!(
+            "every case of {} has finished; nothing to submit",
+            dir.display()
+        );
+        return ExitCode::SUCCESS;
+    }
+    match adhesim::slurm::submit(dir, &numbers) {
+        Ok(id) => {
+            eprintln!(
+                "submitted job {id}: cases {} (logs in {})",
+                adhesim::slurm::array_spec(&numbers),
+                dir.join("slurm").display()
+            );
+            println!("{id}");
+            ExitCode::SUCCESS
+        }
+        Err(e) => fail_input(e),
+    }
+}
+
+/// `adhesim sweep collect DIR`.
+fn collect(dir: &Path, quiet: bool) -> ExitCode {
+    let collected = match adhesim::sweep::collect(dir) {
+        Ok(c) => c,
+        Err(e) => return fail_input(e),
+    };
+    let mut unfinished = 0;
+    for (case, result) in collected.plan.cases.iter().zip(&collected.results) {
+        let case_dir = dir.join(&case.dir);
+        let what = match result {
+            Ok(s) => match &s.outcome {
+                Outcome::Finished => None,
+                Outcome::Failed(m) => Some(format!("failed at t = {:.4e} s: {m}", s.t_reached)),
+                Outcome::Interrupted => Some(format!(
+                    "interrupted at t = {:.4e} s (resubmit to resume it)",
+                    s.t_reached
+                )),
+                Outcome::Running if adhesim::outdir::is_locked(&case_dir) => {
+                    Some(format!("running, at t = {:.4e} s", s.t_reached))
+                }
+                Outcome::Running => Some(format!(
+                    "killed at t = {:.4e} s or later (no process holds its lock; resubmit to resume it)",
+                    s.t_reached
+                )),
+            },
+            Err(m) => Some(m.clone()),
+        };
+        if let Some(what) = what {
+            unfinished += 1;
+            eprintln!("case {} ({}): {what}", case.number, case.label);
+        }
+    }
+    if !quiet {
+        eprintln!(
+            "{} of {} cases finished; summary {}, {} comparison figures in {}",
+            collected.plan.cases.len() - unfinished,
+            collected.plan.cases.len(),
+            dir.join("sweep.csv").display(),
+            collected.figures.len(),
+            dir.join("figures").display()
+        );
+    }
+    if unfinished > 0 {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS

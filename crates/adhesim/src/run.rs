@@ -8,6 +8,9 @@
 //! `running`), rewritten at every checkpoint and at the end (`finished`, `interrupted` or
 //! `failed` with its message), each time atomically; a run.json that says `running` after
 //! the process has gone belongs to a run that was killed.
+//!
+//! The output folder is locked for the whole run and a folder holding a previous run is
+//! only written over on request (see [`crate::outdir`]).
 
 use crate::checkpoint::{fingerprint, Checkpoint, CheckpointError};
 use crate::output::maps::MapObserver;
@@ -36,7 +39,7 @@ impl Progress for Silent {
 }
 
 /// How a run ended.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case", tag = "status", content = "message")]
 pub enum Outcome {
     /// Reached the end time.
@@ -63,6 +66,9 @@ pub struct RunControl {
     pub stop: Option<Arc<AtomicBool>>,
     /// Stop the same way once this many steps have been committed (counted from t = 0).
     pub stop_after_steps: Option<usize>,
+    /// Refuse to start a new run (not a resumed one) in a folder that holds a previous run
+    /// (see [`crate::outdir`]); when false, that run's outputs are removed first.
+    pub refuse_existing_run: bool,
 }
 
 impl RunControl {
@@ -73,7 +79,7 @@ impl RunControl {
 }
 
 /// Where a checkpoint was taken.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CheckpointInfo {
     /// Committed steps.
     pub step: usize,
@@ -82,7 +88,7 @@ pub struct CheckpointInfo {
 }
 
 /// What a run did.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct RunSummary {
     /// Run name.
     pub name: String,
@@ -134,6 +140,9 @@ pub enum RunError {
     /// A checkpoint could not be written, read or used.
     #[error(transparent)]
     Checkpoint(#[from] CheckpointError),
+    /// The output folder is in use by another run, or holds a run that would be lost.
+    #[error(transparent)]
+    OutDir(#[from] crate::outdir::OutDirError),
 }
 
 /// Runs `problem`, writing outputs to `out_dir`; returns the summary (also written to
@@ -165,12 +174,19 @@ pub fn run_with(
         dir: out_dir.to_path_buf(),
         source,
     };
+    // Held until the run returns; the operating system releases it if the process dies.
+    let _lock = if control.resume && !out_dir.is_dir() {
+        None // nothing to resume: reading the checkpoint below says so
+    } else {
+        Some(crate::outdir::lock(out_dir)?)
+    };
     let resume_from = if control.resume {
         let c = Checkpoint::read(out_dir)?;
         c.check_matches(&problem, out_dir)?;
         Some(c)
     } else {
         std::fs::create_dir_all(out_dir).map_err(io_err)?;
+        crate::outdir::prepare_fresh(out_dir, !control.refuse_existing_run)?;
         None
     };
     let fingerprint = fingerprint(&problem);

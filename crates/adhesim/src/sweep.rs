@@ -5,15 +5,18 @@
 //! - `caseNN_<label>/`: a complete run of each case (history, frames, figures, run.json);
 //! - `sweep.csv`: one row per case: its values, how it ended, its cost, and for every tracked
 //!   quantity (`<track>.<field>`, `<pair>.<field>`) the maximum, minimum and final value;
-//! - `figures/<column>.png`: one figure per tracked quantity, one curve per case.
+//! - `figures/<column>.png`: one figure per tracked quantity, one curve per case;
+//! - `sweep.json`: the plan (scenario, variant, fixed overrides, axes, cases), written
+//!   before any case runs, from which a sweep is resumed, submitted to Slurm
+//!   ([`crate::slurm`]) or collected ([`collect`]) from whatever cases have run.
 
 use crate::output::csv::read_history;
 use crate::output::plot::{draw_line_plot, LinePlot, PlotError, Series};
 use crate::run::{Outcome, RunSummary, Silent};
 use crate::scenario::{LoadOptions, Override, ScenarioError};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 
 /// One swept key and its values.
 #[derive(Clone, Debug)]
@@ -125,20 +128,227 @@ pub fn cases(axes: &[Axis]) -> Vec<Case> {
         .collect()
 }
 
+/// A sweep as written to `DIR/sweep.json` before any case runs: enough to run, resume,
+/// submit or collect it later, from this machine or a cluster's nodes.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SweepPlan {
+    /// adhesim version that wrote the plan.
+    pub version: String,
+    /// Scenario file (absolute path).
+    pub scenario: PathBuf,
+    /// Variant applied to every case.
+    pub variant: Option<String>,
+    /// Overrides common to every case, `KEY=VALUE` as given.
+    pub fixed: Vec<String>,
+    /// Swept keys and their values as given.
+    pub axes: Vec<PlannedAxis>,
+    /// The cases, in order.
+    pub cases: Vec<PlannedCase>,
+}
+
+/// One swept key of a [`SweepPlan`].
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PlannedAxis {
+    /// Dotted key.
+    pub key: String,
+    /// Values as written.
+    pub values: Vec<String>,
+}
+
+/// One case of a [`SweepPlan`].
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PlannedCase {
+    /// Case number (1-based; the Slurm array index).
+    pub number: usize,
+    /// Legend label.
+    pub label: String,
+    /// Sub-folder of the sweep folder.
+    pub dir: String,
+    /// The case's own overrides, `KEY=VALUE` (after the fixed ones).
+    pub set: Vec<String>,
+}
+
+/// File name of the plan in a sweep folder.
+pub const PLAN_FILE: &str = "sweep.json";
+
+impl SweepPlan {
+    /// The plan of the cartesian product of `axes` on `scenario` (made absolute), with the
+    /// variant and the fixed overrides (`KEY=VALUE`) common to every case.
+    pub fn new(
+        scenario: &Path,
+        variant: Option<String>,
+        fixed: &[String],
+        axes: &[Axis],
+    ) -> Result<SweepPlan, SweepError> {
+        if axes.is_empty() {
+            return Err(SweepError::Axes(
+                "a sweep needs at least one --set key=v1,v2,...".into(),
+            ));
+        }
+        for a in axes {
+            if a.values.is_empty() {
+                return Err(SweepError::Axes(format!("`{}` has no values", a.key)));
+            }
+            if axes.iter().filter(|b| b.key == a.key).count() > 1 {
+                return Err(SweepError::Axes(format!("`{}` is swept twice", a.key)));
+            }
+        }
+        for f in fixed {
+            Override::parse(f).map_err(|e| SweepError::Axes(format!("--fix: {e}")))?;
+        }
+        let scenario = std::path::absolute(scenario).map_err(|source| SweepError::Io {
+            path: scenario.to_path_buf(),
+            source,
+        })?;
+        Ok(SweepPlan {
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            scenario,
+            variant,
+            fixed: fixed.to_vec(),
+            axes: axes
+                .iter()
+                .map(|a| PlannedAxis {
+                    key: a.key.clone(),
+                    values: a.texts.clone(),
+                })
+                .collect(),
+            cases: cases(axes)
+                .into_iter()
+                .map(|c| PlannedCase {
+                    number: c.index + 1,
+                    set: axes
+                        .iter()
+                        .zip(&c.texts)
+                        .map(|(a, t)| format!("{}={t}", a.key))
+                        .collect(),
+                    label: c.label,
+                    dir: c.dir_name,
+                })
+                .collect(),
+        })
+    }
+
+    /// The axes, parsed back from the plan.
+    pub fn parsed_axes(&self) -> Vec<Axis> {
+        self.axes
+            .iter()
+            .map(|a| Axis {
+                key: a.key.clone(),
+                values: a
+                    .values
+                    .iter()
+                    .map(|v| crate::scenario::prepare::parse_value(v))
+                    .collect(),
+                texts: a.values.clone(),
+            })
+            .collect()
+    }
+
+    /// The cases, parsed back from the plan.
+    pub fn parsed_cases(&self) -> Vec<Case> {
+        cases(&self.parsed_axes())
+    }
+
+    /// The arguments of `adhesim run` that give case `c` (after the scenario file):
+    /// `--variant V` and one `--set KEY=VALUE` per fixed and per swept value.
+    pub fn run_args(&self, c: &PlannedCase) -> Vec<String> {
+        let mut args = Vec::new();
+        if let Some(v) = &self.variant {
+            args.push("--variant".to_string());
+            args.push(v.clone());
+        }
+        for s in self.fixed.iter().chain(&c.set) {
+            args.push("--set".to_string());
+            args.push(s.clone());
+        }
+        args
+    }
+
+    /// How each case is loaded: the variant, then the fixed overrides, then its own.
+    fn load_options(&self, c: &PlannedCase) -> LoadOptions {
+        LoadOptions {
+            variant: self.variant.clone(),
+            overrides: self
+                .fixed
+                .iter()
+                .chain(&c.set)
+                .filter_map(|s| Override::parse(s).ok())
+                .collect(),
+        }
+    }
+
+    /// Loads every case's problem; the first invalid case stops it.
+    pub fn load_cases(&self) -> Result<Vec<crate::problem::Problem>, SweepError> {
+        self.cases
+            .iter()
+            .map(|c| {
+                crate::scenario::load_with(&self.scenario, &self.load_options(c)).map_err(
+                    |source| SweepError::Scenario {
+                        label: c.label.clone(),
+                        source,
+                    },
+                )
+            })
+            .collect()
+    }
+
+    /// Whether `other` describes the same study (the version that wrote it aside).
+    pub fn same_study(&self, other: &SweepPlan) -> bool {
+        self.scenario == other.scenario
+            && self.variant == other.variant
+            && self.fixed == other.fixed
+            && self.axes == other.axes
+    }
+
+    /// Writes `dir/sweep.json` atomically, creating `dir`.
+    pub fn write(&self, dir: &Path) -> Result<(), SweepError> {
+        std::fs::create_dir_all(dir).map_err(|source| SweepError::Io {
+            path: dir.to_path_buf(),
+            source,
+        })?;
+        let path = dir.join(PLAN_FILE);
+        let json = serde_json::to_vec_pretty(self).expect("plan serialises");
+        crate::output::atomic::write_atomic(&path, &json)
+            .map_err(|source| SweepError::Io { path, source })
+    }
+
+    /// Reads `dir/sweep.json`.
+    pub fn read(dir: &Path) -> Result<SweepPlan, SweepError> {
+        let path = dir.join(PLAN_FILE);
+        let bytes = std::fs::read(&path).map_err(|source| SweepError::Read {
+            path: path.clone(),
+            source,
+        })?;
+        serde_json::from_slice(&bytes).map_err(|e| SweepError::Plan {
+            path,
+            reason: e.to_string(),
+        })
+    }
+}
+
 /// How a sweep is run.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct SweepOptions {
-    /// Variant and overrides common to every case.
-    pub base: LoadOptions,
     /// Cases run at the same time.
     pub jobs: usize,
     /// Threads of each case's own pool (element loops, factorisation).
     pub threads_per_case: usize,
+    /// Each case writes a checkpoint every this many steps (0: only when stopped).
+    pub checkpoint_every: usize,
+    /// Continue the sweep in the output folder: finished (and failed) cases are kept,
+    /// interrupted or killed ones resume from their checkpoints, the others start.
+    pub resume: bool,
+    /// Replace a previous sweep in the output folder (each case's outputs are removed before
+    /// it runs).
+    pub overwrite: bool,
+    /// When set (by a signal handler), running cases stop after their current step with a
+    /// checkpoint and no further case starts.
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 /// Receives sweep progress (the CLI prints lines).
 pub trait SweepProgress: Sync {
-    /// A case starts.
+    /// A case starts (or resumes).
     fn started(&self, case: &Case, total: usize);
     /// A case ended (or could not run: `Err`).
     fn finished(&self, case: &Case, total: usize, result: &Result<RunSummary, String>);
@@ -173,6 +383,25 @@ pub enum SweepError {
         /// The I/O error.
         source: std::io::Error,
     },
+    /// A sweep folder's plan cannot be read.
+    #[error("cannot read {path} (is this a sweep folder? `adhesim sweep` writes it): {source}")]
+    Read {
+        /// The plan file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// A sweep plan (sweep.json) cannot be read.
+    #[error("{path} is not a sweep plan written by adhesim: {reason}")]
+    Plan {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The output folder holds another sweep, or none to resume.
+    #[error("{0}")]
+    Folder(String),
     /// A comparison figure could not be drawn.
     #[error(transparent)]
     Plot(#[from] PlotError),
@@ -183,79 +412,117 @@ pub enum SweepError {
 pub struct SweepSummary {
     /// The cases, in order.
     pub cases: Vec<Case>,
-    /// Each case's run summary, or why it could not run.
+    /// Each case's run summary, or why it has none.
     pub results: Vec<Result<RunSummary, String>>,
+    /// Cases kept from a previous session of a resumed sweep.
+    pub kept: usize,
+    /// Whether a stop request ended the sweep early.
+    pub interrupted: bool,
     /// Comparison figures written.
     pub figures: Vec<PathBuf>,
     /// Wall time of the whole sweep [s].
     pub wall_time: f64,
 }
 
-/// Runs every case of `axes` on `scenario` into `out_dir`, `options.jobs` at a time.
-/// Every case is validated first, so that a bad value stops the sweep before anything runs.
+/// Checks whether `plan` may be written to `out_dir`, given a sweep already there: a new
+/// sweep needs an empty folder (or `overwrite`), a resumed one the same study.
+pub fn check_folder(
+    plan: &SweepPlan,
+    out_dir: &Path,
+    resume: bool,
+    overwrite: bool,
+) -> Result<(), SweepError> {
+    let exists = out_dir.join(PLAN_FILE).exists();
+    match (exists, resume) {
+        (false, true) => Err(SweepError::Folder(format!(
+            "{} holds no sweep to resume (no {PLAN_FILE}); start it without --resume",
+            out_dir.display()
+        ))),
+        (true, true) => {
+            let old = SweepPlan::read(out_dir)?;
+            if old.same_study(plan) {
+                Ok(())
+            } else {
+                Err(SweepError::Folder(format!(
+                    "{} holds another sweep ({} with {}); resume it with the same scenario, \
+                     --variant, --fix and --set, or start this one with another --out",
+                    out_dir.display(),
+                    old.scenario.display(),
+                    old.axes
+                        .iter()
+                        .map(|a| format!("{}={}", a.key, a.values.join(",")))
+                        .collect::<Vec<_>>()
+                        .join(" ")
+                )))
+            }
+        }
+        (true, false) if !overwrite => Err(SweepError::Folder(format!(
+            "{} holds a sweep already; continue it with --resume, or replace it with --overwrite",
+            out_dir.display()
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// Runs every case of `plan` into `out_dir`, `options.jobs` at a time, after writing the
+/// plan there. Every case is validated first, so that a bad value stops the sweep before
+/// anything runs. The table and figures are then assembled as by [`collect`].
 pub fn run_sweep(
-    scenario: &Path,
-    axes: &[Axis],
+    plan: &SweepPlan,
     options: &SweepOptions,
     out_dir: &Path,
     progress: &dyn SweepProgress,
 ) -> Result<SweepSummary, SweepError> {
     let start = std::time::Instant::now();
-    if axes.is_empty() {
-        return Err(SweepError::Axes(
-            "a sweep needs at least one --set key=v1,v2,...".into(),
-        ));
-    }
-    for a in axes {
-        if a.values.is_empty() {
-            return Err(SweepError::Axes(format!("`{}` has no values", a.key)));
-        }
-        if axes.iter().filter(|b| b.key == a.key).count() > 1 {
-            return Err(SweepError::Axes(format!("`{}` is swept twice", a.key)));
-        }
-    }
-    let cases = cases(axes);
-    let case_options = |c: &Case| LoadOptions {
-        variant: options.base.variant.clone(),
-        overrides: options
-            .base
-            .overrides
-            .iter()
-            .chain(&c.overrides)
-            .cloned()
-            .collect(),
-    };
     // Each case is loaded once: here, so that a bad value stops the sweep before anything
     // runs, and the worker that runs it takes it from its slot.
-    let problems = cases
-        .iter()
-        .map(|c| {
-            crate::scenario::load_with(scenario, &case_options(c))
-                .map(|p| Mutex::new(Some(p)))
-                .map_err(|source| SweepError::Scenario {
-                    label: c.label.clone(),
-                    source,
-                })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    std::fs::create_dir_all(out_dir).map_err(|source| SweepError::Io {
-        path: out_dir.to_path_buf(),
-        source,
-    })?;
+    let problems: Vec<Mutex<Option<crate::problem::Problem>>> = plan
+        .load_cases()?
+        .into_iter()
+        .map(|p| Mutex::new(Some(p)))
+        .collect();
+    // One sweep at a time in a folder (each case also locks its own).
+    let _lock = crate::outdir::lock(out_dir).map_err(|e| SweepError::Folder(e.to_string()))?;
+    check_folder(plan, out_dir, options.resume, options.overwrite)?;
+    plan.write(out_dir)?;
+    let cases = plan.parsed_cases();
     let results: Mutex<Vec<Option<Result<RunSummary, String>>>> =
         Mutex::new(vec![None; cases.len()]);
+    let kept = AtomicUsize::new(0);
     let next = AtomicUsize::new(0);
-    let jobs = options.jobs.clamp(1, cases.len());
+    let jobs = options.jobs.clamp(1, cases.len().max(1));
     let total = cases.len();
+    let stopped = || {
+        options
+            .stop
+            .as_ref()
+            .is_some_and(|s| s.load(Ordering::SeqCst))
+    };
     std::thread::scope(|scope| {
         for _ in 0..jobs {
             scope.spawn(|| loop {
                 let i = next.fetch_add(1, Ordering::SeqCst);
                 let Some(case) = cases.get(i) else { break };
+                if stopped() {
+                    break;
+                }
+                let dir = out_dir.join(&case.dir_name);
+                if options.resume {
+                    if let Some(done) = read_run(&dir)
+                        .filter(|s| matches!(s.outcome, Outcome::Finished | Outcome::Failed(_)))
+                    {
+                        kept.fetch_add(1, Ordering::SeqCst);
+                        progress.finished(case, total, &Ok(done.clone()));
+                        if let Ok(mut r) = results.lock() {
+                            r[i] = Some(Ok(done));
+                        }
+                        continue;
+                    }
+                }
                 progress.started(case, total);
                 let problem = problems[i].lock().ok().and_then(|mut p| p.take());
                 let result = match problem {
-                    Some(problem) => run_case(scenario, case, problem, options, out_dir),
+                    Some(problem) => run_case(&plan.scenario, &dir, problem, options),
                     None => Err("the case's scenario is not available".into()),
                 };
                 progress.finished(case, total, &result);
@@ -265,40 +532,114 @@ pub fn run_sweep(
             });
         }
     });
-    let results: Vec<Result<RunSummary, String>> = results
-        .into_inner()
-        .unwrap_or_default()
-        .into_iter()
-        .map(|r| r.unwrap_or_else(|| Err("the case did not run".into())))
-        .collect();
-    let histories: Vec<Option<History>> = cases
-        .iter()
-        .map(|c| read_history(out_dir.join(&c.dir_name).join("history.csv")).ok())
-        .collect();
-    write_summary(out_dir, axes, &cases, &results, &histories)?;
-    let figures = draw_comparison(out_dir, &cases, &histories)?;
+    let results = results.into_inner().unwrap_or_default();
+    let collected = assemble(out_dir, plan, &cases, &results)?;
     Ok(SweepSummary {
         cases,
-        results,
-        figures,
+        results: collected.results,
+        kept: kept.into_inner(),
+        interrupted: stopped(),
+        figures: collected.figures,
         wall_time: start.elapsed().as_secs_f64(),
     })
 }
 
+/// Runs one case into `dir`: resumed from its checkpoint when the sweep is resumed and
+/// there is one, otherwise from the start.
 fn run_case(
     scenario: &Path,
-    case: &Case,
+    dir: &Path,
     problem: crate::problem::Problem,
     options: &SweepOptions,
-    out_dir: &Path,
 ) -> Result<RunSummary, String> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(options.threads_per_case.max(1))
         .build()
         .map_err(|e| format!("cannot start the case's threads: {e}"))?;
-    let dir = out_dir.join(&case.dir_name);
-    pool.install(|| crate::run::run(problem, Some(scenario), &dir, &mut Silent))
+    let resume = options.resume && crate::checkpoint::Checkpoint::path(dir).exists();
+    let control = crate::run::RunControl {
+        checkpoint_every: options.checkpoint_every,
+        resume,
+        stop: options.stop.clone(),
+        stop_after_steps: None,
+        // A resumed sweep restarts a case that has no checkpoint (never started, or killed
+        // before its first one); a new sweep only writes over a case with --overwrite.
+        refuse_existing_run: !(options.resume || options.overwrite),
+    };
+    pool.install(|| crate::run::run_with(problem, Some(scenario), dir, &mut Silent, &control))
         .map_err(|e| e.to_string())
+}
+
+/// The run summary in `dir/run.json`, if there is a readable one.
+pub fn read_run(dir: &Path) -> Option<RunSummary> {
+    serde_json::from_slice(&std::fs::read(dir.join("run.json")).ok()?).ok()
+}
+
+/// What [`collect`] found.
+#[derive(Debug)]
+pub struct Collected {
+    /// The plan.
+    pub plan: SweepPlan,
+    /// Each case's run summary (from its run.json), or why it has none.
+    pub results: Vec<Result<RunSummary, String>>,
+    /// Comparison figures written.
+    pub figures: Vec<PathBuf>,
+}
+
+/// Assembles `sweep.csv` and the comparison figures of the sweep in `out_dir` (its
+/// `sweep.json` names the cases) from whatever cases have run so far: each case's row comes
+/// from its run.json and history.csv, as they are on disk. Cases without a run.json are
+/// listed as `not run`.
+pub fn collect(out_dir: &Path) -> Result<Collected, SweepError> {
+    let plan = SweepPlan::read(out_dir)?;
+    let cases = plan.parsed_cases();
+    if cases.len() != plan.cases.len()
+        || cases
+            .iter()
+            .zip(&plan.cases)
+            .any(|(c, p)| c.dir_name != p.dir)
+    {
+        return Err(SweepError::Plan {
+            path: out_dir.join(PLAN_FILE),
+            reason: "its cases do not match its axes".into(),
+        });
+    }
+    let none = vec![None; cases.len()];
+    assemble(out_dir, &plan, &cases, &none)
+}
+
+/// Reads every case's outcome from disk (falling back to `known`, the in-memory result of
+/// a case that could not write a run.json), writes sweep.csv and the figures.
+fn assemble(
+    out_dir: &Path,
+    plan: &SweepPlan,
+    cases: &[Case],
+    known: &[Option<Result<RunSummary, String>>],
+) -> Result<Collected, SweepError> {
+    let results: Vec<Result<RunSummary, String>> = cases
+        .iter()
+        .zip(known)
+        .map(|(c, k)| {
+            let dir = out_dir.join(&c.dir_name);
+            match (read_run(&dir), k) {
+                (Some(s), _) => Ok(s),
+                (None, Some(Err(m))) => Err(format!("could not run: {m}")),
+                (None, _) if dir.join("run.json").exists() => Err("run.json cannot be read".into()),
+                (None, _) => Err("not run".into()),
+            }
+        })
+        .collect();
+    let histories: Vec<Option<History>> = cases
+        .iter()
+        .map(|c| read_history(out_dir.join(&c.dir_name).join("history.csv")).ok())
+        .collect();
+    write_summary(out_dir, &plan.parsed_axes(), cases, &results, &histories)?;
+    let figures = draw_comparison(out_dir, cases, &histories)?;
+    Ok(Collected {
+        plan: plan.clone(),
+        results,
+        figures,
+    })
 }
 
 /// Quotes a CSV field when it holds a comma or a quote.
@@ -377,7 +718,7 @@ fn write_summary(
                 row.push(format!("{:.3}", s.wall_time));
             }
             Err(m) => {
-                row.push(csv_field(&format!("error: {m}")));
+                row.push(csv_field(m));
                 row.extend(std::iter::repeat_n(String::new(), 5));
             }
         }
@@ -477,6 +818,46 @@ mod tests {
         assert_eq!(c[3].label, "friction=0.2, v=1.0");
         assert_eq!(c[5].dir_name, "case06_friction=0.2_v=0.6");
         assert_eq!(c[4].overrides[1].value, toml::Value::Float(0.8));
+    }
+
+    #[test]
+    fn a_plan_survives_its_json_and_gives_each_case_its_run_arguments() {
+        let axes = vec![
+            Axis::parse("contact.top.friction=0,0.2").unwrap(),
+            Axis::parse("v=1.0,0.8,0.6").unwrap(),
+        ];
+        let plan = SweepPlan::new(
+            Path::new("/s/x.toml"),
+            None,
+            &["time.dt=1e-4".to_string()],
+            &axes,
+        )
+        .unwrap();
+        assert_eq!(plan.cases.len(), 6);
+        assert_eq!(plan.cases[4].number, 5);
+        assert_eq!(plan.cases[4].dir, "case05_friction=0.2_v=0.8");
+        assert_eq!(
+            plan.run_args(&plan.cases[4]),
+            [
+                "--set",
+                "time.dt=1e-4",
+                "--set",
+                "contact.top.friction=0.2",
+                "--set",
+                "v=0.8"
+            ]
+        );
+        let back: SweepPlan = serde_json::from_slice(&serde_json::to_vec(&plan).unwrap()).unwrap();
+        assert_eq!(back, plan);
+        assert_eq!(
+            back.parsed_cases()
+                .iter()
+                .map(|c| c.dir_name.clone())
+                .collect::<Vec<_>>(),
+            plan.cases.iter().map(|c| c.dir.clone()).collect::<Vec<_>>()
+        );
+        let other = SweepPlan::new(Path::new("/s/x.toml"), None, &[], &axes).unwrap();
+        assert!(!plan.same_study(&other), "the fixed overrides differ");
     }
 
     #[test]
