@@ -86,6 +86,14 @@ def compare_forces(adh, ccx, tol):
     return rows
 
 
+def load_average():
+    try:
+        with open("/proc/loadavg") as f:
+            return [float(x) for x in f.read().split()[:3]]
+    except (OSError, ValueError):
+        return None
+
+
 def adhesim_record(a):
     rows = read_history(f"{a.dir}/history.csv", a.pair)
     wall, rss = read_time_v(a.time_v)
@@ -117,6 +125,7 @@ def adhesim_record(a):
         "step_median": {k: statistics.median(v) if v else None for k, v in per_step.items()},
         "step_total": {k: sum(v) for k, v in per_step.items()},
         "status": run.get("status"),
+        "load": load_average(),
         "forces": history_forces(rows, a.pair),
     }
 
@@ -146,6 +155,7 @@ def ccx_record(a):
         "steps": len(forces),
         "cutbacks": cutbacks,
         "newton": iterations,
+        "load": load_average(),
         "forces": forces,
     }
 
