@@ -84,11 +84,14 @@ def main(argv=None):
         w(f"\n## adhesim: {solver}\n")
         commits = sorted({r.get("commit", "") for rs in by_n.values() for r in rs})
         w(f"adhesim commit(s): {', '.join(commits)}.\n")
-        w("\n### Wall time and peak memory (medians over the runs)\n")
-        w("| contact nodes | n | DOFs | adhesim runs | adhesim wall | adhesim memory | "
-          "CalculiX runs | CalculiX wall | CalculiX memory | wall adhesim / CalculiX | "
-          "memory adhesim / CalculiX |")
-        w("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+        w("\n### Wall time, CPU time and peak memory (medians over the runs)\n")
+        w("CPU = user + system time of the process (`/usr/bin/time -v`): on a loaded machine "
+          "it is the steadier measure; with one thread it is close to the wall time of an "
+          "idle machine.\n")
+        w("| contact nodes | n | DOFs | adhesim runs | adhesim wall | adhesim CPU | "
+          "adhesim memory | CalculiX runs | CalculiX wall | CalculiX CPU | CalculiX memory | "
+          "wall adhesim / CalculiX | CPU adhesim / CalculiX | memory adhesim / CalculiX |")
+        w("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
         for n in sizes:
             ra = [r for r in by_n.get(n, []) if ok(r)]
             rc = [r for r in ccx.get(n, []) if ok(r)]
@@ -96,10 +99,14 @@ def main(argv=None):
                 continue
             wa, ma = median([r["wall"] for r in ra]), median([r["rss_kb"] for r in ra])
             wc, mc = median([r["wall"] for r in rc]), median([r["rss_kb"] for r in rc])
-            ratio = f"{wa / wc:.2f}" if wa and wc else "–"
-            mratio = f"{ma / mc:.2f}" if ma and mc else "–"
-            w(f"| {nodes[n]} | {n} | {dofs[n]} | {len(ra)} | {fmt_time(wa)} | {fmt_mem(ma)} | "
-              f"{len(rc)} | {fmt_time(wc)} | {fmt_mem(mc)} | {ratio} | {mratio} |")
+            ca, cc = median([r.get("cpu") for r in ra]), median([r.get("cpu") for r in rc])
+
+            def ratio(x, y):
+                return f"{x / y:.2f}" if x and y else "–"
+
+            w(f"| {nodes[n]} | {n} | {dofs[n]} | {len(ra)} | {fmt_time(wa)} | {fmt_time(ca)} | "
+              f"{fmt_mem(ma)} | {len(rc)} | {fmt_time(wc)} | {fmt_time(cc)} | {fmt_mem(mc)} | "
+              f"{ratio(wa, wc)} | {ratio(ca, cc)} | {ratio(ma, mc)} |")
         failed = [r for rs in by_n.values() for r in rs if not ok(r)]
         if failed:
             w("\nRuns left out (non-zero exit or no committed step): "
@@ -144,9 +151,9 @@ def main(argv=None):
               f"{'yes' if all(x['ok'] for x in rows) else 'NO'} |")
 
     w("\n## CalculiX runs\n")
-    w("| contact nodes | runs | wall (median) | memory (median) | increments | cut-backs | "
-      "iterations | f_y at t = 1 |")
-    w("|---:|---:|---:|---:|---:|---:|---:|---:|")
+    w("| contact nodes | runs | wall (median) | CPU (median) | memory (median) | increments | "
+      "cut-backs | iterations | f_y at t = 1 |")
+    w("|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for n in sizes:
         rc = [r for r in ccx.get(n, []) if ok(r)]
         if not rc:
@@ -154,6 +161,7 @@ def main(argv=None):
         r = rc[-1]
         fy = [f"{f[2]:.5g} N" for f in r["forces"] if abs(f[0] - 1.0) < 1e-7] or ["–"]
         w(f"| {nodes[n]} | {len(rc)} | {fmt_time(median([x['wall'] for x in rc]))} | "
+          f"{fmt_time(median([x.get('cpu') for x in rc]))} | "
           f"{fmt_mem(median([x['rss_kb'] for x in rc]))} | {r['steps']} | {r['cutbacks']} | "
           f"{r['newton']} | {fy[0]} |")
     bad = [r for rs in ccx.values() for r in rs if not ok(r)]

@@ -28,7 +28,14 @@ NON_CONTACT_PHASES = ("time_assembly", "time_factorisation")
 
 def read_time_v(path):
     """Wall time [s] and peak resident memory [kB] from the report of `/usr/bin/time -v`."""
-    wall, rss = None, None
+    wall, rss, _ = read_time_v_full(path)
+    return wall, rss
+
+
+def read_time_v_full(path):
+    """Wall time [s], peak resident memory [kB] and CPU time (user + system) [s] from the
+    report of `/usr/bin/time -v`."""
+    wall, rss, cpu = None, None, 0.0
     with open(path) as f:
         for line in f:
             line = line.strip()
@@ -40,9 +47,9 @@ def read_time_v(path):
                     wall = wall * 60.0 + p
             elif line.startswith("Maximum resident set size"):
                 rss = int(line.split(":")[1])
-            elif line.startswith("Exit status"):
-                pass
-    return wall, rss
+            elif line.startswith(("User time", "System time")):
+                cpu += float(line.split(":")[1])
+    return wall, rss, cpu
 
 
 def read_history(path, pair="ground"):
@@ -96,7 +103,7 @@ def load_average():
 
 def adhesim_record(a):
     rows = read_history(f"{a.dir}/history.csv", a.pair)
-    wall, rss = read_time_v(a.time_v)
+    wall, rss, cpu = read_time_v_full(a.time_v)
     phases = [c for c in rows[0] if c.startswith("time_")] if rows else []
     contact_cols = [c for c in phases if c not in NON_CONTACT_PHASES]
     per_step = {
@@ -117,6 +124,7 @@ def adhesim_record(a):
         "threads": a.threads,
         "exit": a.exit,
         "wall": wall,
+        "cpu": cpu,
         "rss_kb": rss,
         "steps": len(rows),
         "cutbacks": int(sum(r["cutbacks"] for r in rows)),
@@ -131,7 +139,7 @@ def adhesim_record(a):
 
 
 def ccx_record(a):
-    wall, rss = read_time_v(a.time_v)
+    wall, rss, cpu = read_time_v_full(a.time_v)
     iterations = attempts = cutbacks = 0
     try:
         with open(f"{a.job}.log") as f:
@@ -151,6 +159,7 @@ def ccx_record(a):
         "threads": a.threads,
         "exit": a.exit,
         "wall": wall,
+        "cpu": cpu,
         "rss_kb": rss,
         "steps": len(forces),
         "cutbacks": cutbacks,
