@@ -43,7 +43,10 @@ fn normal_force(sets: &[&str], tag: &str) -> Vec<(f64, f64)> {
 
 fn final_force(forces: &[(f64, f64)]) -> f64 {
     let &(t, f) = forces.last().unwrap();
-    assert!((t - 1.0).abs() < 1e-12, "the run should end at t = 1, not {t}");
+    assert!(
+        (t - 1.0).abs() < 1e-12,
+        "the run should end at t = 1, not {t}"
+    );
     f
 }
 
