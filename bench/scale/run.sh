@@ -99,9 +99,14 @@ commit="$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)"
 solver_args=()
 if [ -n "$solver" ]; then
     for key in contact.ground.contact_solver time.contact_solver; do
-        if "$adhesim" check "$scenario" --set "$key=\"$solver\"" >/dev/null 2>&1; then
+        if msg="$("$adhesim" check "$scenario" --set "$key=\"$solver\"" 2>&1)"; then
             solver_args=(--set "$key=\"$solver\"")
             break
+        elif ! grep -q 'unknown field `contact_solver`' <<< "$msg"; then
+            # The key exists but the value (or something else) is refused: say why.
+            echo "run.sh: adhesim refuses $key=\"$solver\":" >&2
+            echo "$msg" >&2
+            exit 2
         fi
     done
     if [ ${#solver_args[@]} -eq 0 ]; then
