@@ -8,6 +8,7 @@
 
 pub mod detect;
 pub mod law;
+pub mod newton;
 pub mod solve;
 
 pub use detect::{ContactPair, Master, RigidMotion, RigidShape};
