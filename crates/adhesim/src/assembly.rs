@@ -3,8 +3,10 @@
 //! without locks, and the constant mass matrix.
 
 use crate::element::{
-    consistent_mass, element_response, hex8_geometry, tet4_geometry, DegenerateElement, GaussPoint,
+    consistent_mass, element_response, hex8_centre, hex8_geometry, tet4_geometry,
+    DegenerateElement, GaussPoint,
 };
+use crate::fbar::{fbar_element_response, Formulation};
 use crate::linalg::BlockPattern;
 use crate::material::Hyperelastic;
 use crate::mesh::Mesh;
@@ -19,6 +21,8 @@ pub struct ElementBlock<const N: usize, const G: usize> {
     pub gauss: Vec<[GaussPoint<N>; G]>,
     /// Index of the owning body.
     pub body: Vec<usize>,
+    /// Shape-function gradients at the element centre, for F-bar elements (`None`: standard).
+    pub centre: Vec<Option<GaussPoint<N>>>,
     /// For local pair (a, b): rank of min(node a, node b) among the upper neighbours of
     /// max(node a, node b) in the pattern.
     ranks: Vec<[[u32; N]; N]>,
@@ -32,6 +36,7 @@ impl<const N: usize, const G: usize> ElementBlock<N, G> {
             nodes: vec![],
             gauss: vec![],
             body: vec![],
+            centre: vec![],
             ranks: vec![],
             colours: vec![],
         }
@@ -156,6 +161,15 @@ impl Discretisation {
     /// Builds the discretisation of the given bodies (mesh, material). Fails with the list
     /// of degenerate or inverted reference elements.
     pub fn new(bodies: &[(&Mesh, Arc<dyn Hyperelastic>)]) -> Result<Self, Vec<BadElement>> {
+        Self::with_formulations(bodies, &[])
+    }
+
+    /// As [`Discretisation::new`], with the element formulation of each body's hexahedra
+    /// (bodies beyond the end of `formulations` use the standard element).
+    pub fn with_formulations(
+        bodies: &[(&Mesh, Arc<dyn Hyperelastic>)],
+        formulations: &[Formulation],
+    ) -> Result<Self, Vec<BadElement>> {
         let mut node_offset = Vec::new();
         let mut reference = Vec::new();
         let mut hexes = ElementBlock::<8, 8>::empty();
@@ -165,6 +179,7 @@ impl Discretisation {
             let off = reference.len();
             node_offset.push(off);
             reference.extend_from_slice(&mesh.nodes);
+            let fbar = formulations.get(bi) == Some(&Formulation::FBar);
             for (ci, h) in mesh.hexes.iter().enumerate() {
                 let x = h.map(|n| mesh.nodes[n]);
                 match hex8_geometry(&x) {
@@ -172,6 +187,9 @@ impl Discretisation {
                         hexes.nodes.push(h.map(|n| n + off));
                         hexes.gauss.push(g);
                         hexes.body.push(bi);
+                        hexes
+                            .centre
+                            .push(if fbar { hex8_centre(&x).ok() } else { None });
                     }
                     Err(DegenerateElement { det }) => bad.push(BadElement {
                         body: bi,
@@ -187,6 +205,7 @@ impl Discretisation {
                         tets.nodes.push(t.map(|n| n + off));
                         tets.gauss.push(g);
                         tets.body.push(bi);
+                        tets.centre.push(None);
                     }
                     Err(DegenerateElement { det }) => bad.push(BadElement {
                         body: bi,
@@ -269,7 +288,12 @@ impl Discretisation {
                         [u[3 * n], u[3 * n + 1], u[3 * n + 2]]
                     });
                     let mat = &*self.materials[block.body[e]];
-                    let r = element_response(&block.gauss[e], &ue, mat, with_tangent);
+                    let r = match &block.centre[e] {
+                        Some(c) => {
+                            fbar_element_response(&block.gauss[e], c, &ue, mat, with_tangent)
+                        }
+                        None => element_response(&block.gauss[e], &ue, mat, with_tangent),
+                    };
                     // SAFETY: elements of one colour share no node, so they write disjoint
                     // entries of the force vector and of the tangent values.
                     unsafe {

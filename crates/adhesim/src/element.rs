@@ -125,6 +125,13 @@ pub fn hex8_geometry(x: &[[f64; 3]; 8]) -> Result<[GaussPoint<8>; 8], Degenerate
     Ok(out)
 }
 
+/// Shape-function data at the centre (ξ = 0) of a hex8 with reference coordinates `x` [m],
+/// weight 8 (the natural volume), as the F-bar element needs.
+pub fn hex8_centre(x: &[[f64; 3]; 8]) -> Result<GaussPoint<8>, DegenerateElement> {
+    let (n, dn) = hex8_shape([0.0; 3]);
+    gauss_point(x, n, dn, 8.0)
+}
+
 /// Gauss-point data of a tet4 with reference coordinates `x` [m] (one point, weight 1/6).
 pub fn tet4_geometry(x: &[[f64; 3]; 4]) -> Result<[GaussPoint<4>; 1], DegenerateElement> {
     let (n, dn) = tet4_shape([0.25; 3]);

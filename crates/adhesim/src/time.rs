@@ -210,7 +210,9 @@ impl Stepper {
             .iter()
             .map(|b| (&b.mesh, b.material.clone()))
             .collect();
-        let disc = Discretisation::new(&bodies).map_err(SetupError::BadElements)?;
+        let formulations: Vec<_> = problem.bodies.iter().map(|b| b.element).collect();
+        let disc = Discretisation::with_formulations(&bodies, &formulations)
+            .map_err(SetupError::BadElements)?;
         let density: Vec<f64> = problem.bodies.iter().map(|b| b.density).collect();
         let mass = disc.mass(&density, problem.time.lumped_mass);
         let n = disc.num_dofs();

@@ -204,6 +204,7 @@ fn indent(k: usize) -> Indentation {
             material: Arc::new(BlatzKo::new(G)),
             density: 1000.0,
             initial_velocity: [0.0; 3],
+            element: Default::default(),
         }],
         dirichlet: vec![
             fixed(mesh.node_sets["sym_x"].clone(), [true, false, false]),

@@ -29,15 +29,23 @@ pub trait Hyperelastic: Send + Sync + std::fmt::Debug {
 
 mod blatz_ko;
 mod linear_elastic;
+mod mooney_rivlin;
 mod neo_hookean;
+mod ogden;
 mod saint_venant_kirchhoff;
 #[cfg(test)]
 mod test_support;
+mod uncoupled;
+mod uncoupled_neo_hookean;
 
 pub use blatz_ko::BlatzKo;
 pub use linear_elastic::LinearElastic;
+pub use mooney_rivlin::MooneyRivlin;
 pub use neo_hookean::NeoHookean;
+pub use ogden::Ogden;
 pub use saint_venant_kirchhoff::SaintVenantKirchhoff;
+pub use uncoupled::bulk_from_d1;
+pub use uncoupled_neo_hookean::UncoupledNeoHookean;
 
 /// Tensor index pairs (i, j) of the six Voigt components, in the order (11, 22, 33, 12, 23, 13).
 pub const VOIGT_PAIRS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2)];
