@@ -3,8 +3,7 @@
 //! without locks, and the constant mass matrix.
 
 use crate::element::{
-    consistent_mass, element_response, hex8_centre, hex8_geometry, tet4_geometry,
-    DegenerateElement, GaussPoint,
+    consistent_mass, element_response, hex8_geometry, tet4_geometry, DegenerateElement, GaussPoint,
 };
 use crate::fbar::{fbar_element_response, Formulation};
 use crate::linalg::BlockPattern;
@@ -21,8 +20,8 @@ pub struct ElementBlock<const N: usize, const G: usize> {
     pub gauss: Vec<[GaussPoint<N>; G]>,
     /// Index of the owning body.
     pub body: Vec<usize>,
-    /// Shape-function gradients at the element centre, for F-bar elements (`None`: standard).
-    pub centre: Vec<Option<GaussPoint<N>>>,
+    /// True for F-bar elements, false for the standard fully integrated ones.
+    pub fbar: Vec<bool>,
     /// For local pair (a, b): rank of min(node a, node b) among the upper neighbours of
     /// max(node a, node b) in the pattern.
     ranks: Vec<[[u32; N]; N]>,
@@ -36,7 +35,7 @@ impl<const N: usize, const G: usize> ElementBlock<N, G> {
             nodes: vec![],
             gauss: vec![],
             body: vec![],
-            centre: vec![],
+            fbar: vec![],
             ranks: vec![],
             colours: vec![],
         }
@@ -187,9 +186,7 @@ impl Discretisation {
                         hexes.nodes.push(h.map(|n| n + off));
                         hexes.gauss.push(g);
                         hexes.body.push(bi);
-                        hexes
-                            .centre
-                            .push(if fbar { hex8_centre(&x).ok() } else { None });
+                        hexes.fbar.push(fbar);
                     }
                     Err(DegenerateElement { det }) => bad.push(BadElement {
                         body: bi,
@@ -205,7 +202,7 @@ impl Discretisation {
                         tets.nodes.push(t.map(|n| n + off));
                         tets.gauss.push(g);
                         tets.body.push(bi);
-                        tets.centre.push(None);
+                        tets.fbar.push(false);
                     }
                     Err(DegenerateElement { det }) => bad.push(BadElement {
                         body: bi,
@@ -288,11 +285,10 @@ impl Discretisation {
                         [u[3 * n], u[3 * n + 1], u[3 * n + 2]]
                     });
                     let mat = &*self.materials[block.body[e]];
-                    let r = match &block.centre[e] {
-                        Some(c) => {
-                            fbar_element_response(&block.gauss[e], c, &ue, mat, with_tangent)
-                        }
-                        None => element_response(&block.gauss[e], &ue, mat, with_tangent),
+                    let r = if block.fbar[e] {
+                        fbar_element_response(&block.gauss[e], &ue, mat, with_tangent)
+                    } else {
+                        element_response(&block.gauss[e], &ue, mat, with_tangent)
                     };
                     // SAFETY: elements of one colour share no node, so they write disjoint
                     // entries of the force vector and of the tangent values.
