@@ -210,8 +210,7 @@ pub fn fbar_element_response<const N: usize, const G: usize>(
                 let mb = m[b] * (a2 / 3.0) + pg[b] * (wa / 3.0);
                 kab = kab * a2
                     + ma * hv[b].transpose()
-                    + hv[a] * mb.transpose()
-                    + hv[a] * (hv[b] * hh).transpose()
+                    + hv[a] * (mb + hv[b] * hh).transpose()
                     + g[b] * ga.transpose();
                 kt[a][b] += kab;
             }
