@@ -124,9 +124,22 @@ pub fn fbar_element_response<const N: usize, const G: usize>(
     material: &dyn Hyperelastic,
     with_tangent: bool,
 ) -> ElementResponse<N> {
+    fbar_element_response_with_history(gps, u, material, with_tangent, None)
+}
+
+/// As [`fbar_element_response`], for a viscoelastic material (see
+/// [`crate::element::element_response_with_history`]); the material is evaluated at C̄.
+pub fn fbar_element_response_with_history<const N: usize, const G: usize>(
+    gps: &[GaussPoint<N>; G],
+    u: &[[f64; 3]; N],
+    material: &dyn Hyperelastic,
+    with_tangent: bool,
+    history: Option<(&[f64], f64)>,
+) -> ElementResponse<N> {
     if material.small_strain() {
         return crate::element::element_response(gps, u, material, with_tangent);
     }
+    let viscous = history.zip(material.viscoelastic());
     let mut force = [[0.0; 3]; N];
     let mut tangent = if with_tangent {
         Some(Box::new([[Mat3::zeros(); N]; N]))
@@ -154,12 +167,22 @@ pub fn fbar_element_response<const N: usize, const G: usize>(
         let w = gp.weight;
         let cbar = fbar.transpose() * fbar;
         energy += material.energy(&cbar) * w;
-        let (s, dmat) = if with_tangent {
+        let (mut s, mut dmat) = if with_tangent {
             let (s, d) = material.pk2_and_tangent(&cbar);
             (s, Some(d))
         } else {
             (material.pk2(&cbar), None)
         };
+        if let Some(((hist, dt), ve)) = viscous {
+            let len = ve.history_len();
+            ve.add_viscous(
+                &cbar,
+                &hist[q * len..(q + 1) * len],
+                dt,
+                &mut s,
+                dmat.as_mut(),
+            );
+        }
         let p = fbar * s;
         let pf = p.dot(&f);
         let grads: [Vec3; N] = std::array::from_fn(|a| Vec3::from(gp.grad[a]));
@@ -246,6 +269,19 @@ pub fn fbar_element_response<const N: usize, const G: usize>(
         energy,
         min_j,
     }
+}
+
+/// C̄ = F̄ᵀF̄ at each Gauss point of an F-bar element.
+pub fn fbar_gauss_point_c<const N: usize, const G: usize>(
+    gps: &[GaussPoint<N>; G],
+    u: &[[f64; 3]; N],
+) -> [Mat3; G] {
+    let theta = volume_ratio(gps, u);
+    std::array::from_fn(|q| {
+        let f = Mat3::identity() + displacement_gradient(&gps[q], u);
+        let fbar = f * (theta / f.determinant()).cbrt();
+        fbar.transpose() * fbar
+    })
 }
 
 /// Volume-weighted Cauchy stress σ̄ = θ⁻¹ F̄ S(F̄ᵀF̄) F̄ᵀ over the Gauss points of an F-bar

@@ -172,6 +172,7 @@ struct FileMaterial {
     kappa: Option<f64>,
     mu: Option<Vec<f64>>,
     alpha: Option<Vec<f64>>,
+    prony: Option<Vec<[f64; 2]>>,
 }
 
 #[derive(Deserialize, Debug, Clone)]
@@ -1015,7 +1016,33 @@ fn build_material(
         m.model.as_str(),
         "uncoupled-neo-hookean" | "mooney-rivlin" | "ogden"
     ) {
-        return build_uncoupled_material(m, key, ctx);
+        let elastic = build_uncoupled_material(m, key, ctx)?;
+        let Some(prony) = &m.prony else {
+            return Ok(elastic);
+        };
+        if prony.is_empty() || prony.len() > 12 {
+            return Err(ctx.err(format!(
+                "`{key}.prony` needs 1 to 12 terms [[g1, tau1], ...], got {}",
+                prony.len()
+            )));
+        }
+        let mut terms = Vec::new();
+        for (i, &[g, tau]) in prony.iter().enumerate() {
+            if !(g > 0.0 && g < 1.0) {
+                return Err(ctx.err(format!(
+                    "`{key}.prony[{i}]`: the relative modulus g must be in (0, 1), got {g}"
+                )));
+            }
+            ctx.positive(&format!("{key}.prony[{i}] (relaxation time tau [s])"), tau)?;
+            terms.push(material::PronyTerm { g, tau });
+        }
+        let total: f64 = terms.iter().map(|t| t.g).sum();
+        if total >= 1.0 {
+            return Err(ctx.err(format!(
+                "`{key}.prony`: the relative moduli add up to {total}; their sum must stay below 1 (the long-term shear modulus is μ (1 − Σ g))"
+            )));
+        }
+        return Ok(Arc::new(material::Viscoelastic { elastic, terms }));
     }
     let extra = [
         ("c10", m.c10.is_some()),
@@ -1024,6 +1051,7 @@ fn build_material(
         ("kappa", m.kappa.is_some()),
         ("mu", m.mu.is_some()),
         ("alpha", m.alpha.is_some()),
+        ("prony", m.prony.is_some()),
     ];
     if let Some((name, _)) = extra.iter().find(|(_, given)| *given) {
         return Err(ctx.err(format!(

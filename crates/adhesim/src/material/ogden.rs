@@ -142,6 +142,10 @@ impl Hyperelastic for Ogden {
     fn bulk_modulus(&self) -> f64 {
         self.kappa
     }
+
+    fn isochoric_pk2_and_tangent(&self, c: &Mat3) -> Option<(Mat3, Mat6)> {
+        Some(uncoupled::pk2_and_tangent(self, 0.0, c))
+    }
 }
 
 #[cfg(test)]
