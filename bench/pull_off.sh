@@ -6,7 +6,8 @@ set -eu
 cd "$(dirname "$0")/.."
 variant=${1:-}
 out=${OUT:-out/pdms-pull-off-speeds}
-cargo build --release --quiet -p adhesim-cli --example pull_off_figure
+cargo build --release --quiet -p adhesim-cli
+cargo build --release --quiet -p adhesim --example pull_off_figure
 args=""
 for v in 1e-4 1e-3 1e-2; do
     if [ -n "$variant" ]; then
