@@ -1196,7 +1196,7 @@ fn build_uncoupled_material(
             let c01 = m
                 .c01
                 .map_or(Ok(0.0), |v| ctx.finite(&format!("{key}.c01"), v))?;
-            if !(c10 + c01 > 0.0) {
+            if c10 + c01 <= 0.0 {
                 return Err(ctx.err(format!(
                     "`{key}`: the shear modulus 2 (c10 + c01) must be positive, got c10 = {c10}, c01 = {c01}"
                 )));

@@ -267,8 +267,8 @@ fn fbar_patch_reproduces_a_large_homogeneous_deformation() {
     }
     let s = solve(p);
     let mut err: f64 = 0.0;
-    for i in 0..mesh.num_nodes() {
-        let ue = field(mesh.nodes[i]);
+    for (i, &x) in mesh.nodes.iter().enumerate() {
+        let ue = field(x);
         for k in 0..3 {
             err = err.max((s.state.u[3 * i + k] - ue[k]).abs());
         }
