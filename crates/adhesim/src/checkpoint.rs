@@ -2,11 +2,10 @@
 //!
 //! A checkpoint holds the stepper's [`Snapshot`] (time, step counter, u, v, the committed
 //! contact state, the internal variables of viscoelastic materials, the current Δt and its
-//! cut-back bookkeeping, the energy accumulators and
-//! the forces at the start of the next step), how far the outputs got (frames written, the
-//! next frame time, the PVD entries, history rows) and the run's counters. It is tied to the
-//! problem it was written for by a fingerprint, so that resuming with a changed scenario is
-//! refused.
+//! cut-back bookkeeping, the energy accumulators and the forces at the start of the next
+//! step), how far the outputs got (frames written, the next frame time, the PVD entries,
+//! history rows) and the run's counters. It is tied to the problem it was written for by a
+//! fingerprint, so that resuming with a changed scenario is refused.
 //!
 //! File format (`DIR/checkpoint.bin`, little-endian): the magic `ADHCKPT\0`, a format
 //! version (u32), then length-prefixed fields (u64 counts, f64 bit patterns, UTF-8 strings),
