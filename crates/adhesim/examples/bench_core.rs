@@ -1007,6 +1007,7 @@ fn bench_dynamic(n: usize, steps: usize, threads: usize) -> DynamicResult {
             material: material(),
             density: DENSITY,
             initial_velocity: [0.0; 3],
+            element: Default::default(),
         }],
         dirichlet: vec![
             Dirichlet {

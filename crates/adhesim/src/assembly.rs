@@ -3,8 +3,10 @@
 //! without locks, and the constant mass matrix.
 
 use crate::element::{
-    consistent_mass, element_response, hex8_geometry, tet4_geometry, DegenerateElement, GaussPoint,
+    consistent_mass, element_response_with_history, gauss_point_c, hex8_geometry, tet4_geometry,
+    DegenerateElement, GaussPoint,
 };
+use crate::fbar::{fbar_element_response_with_history, fbar_gauss_point_c, Formulation};
 use crate::linalg::BlockPattern;
 use crate::material::Hyperelastic;
 use crate::mesh::Mesh;
@@ -19,6 +21,11 @@ pub struct ElementBlock<const N: usize, const G: usize> {
     pub gauss: Vec<[GaussPoint<N>; G]>,
     /// Index of the owning body.
     pub body: Vec<usize>,
+    /// True for F-bar elements, false for the standard fully integrated ones.
+    pub fbar: Vec<bool>,
+    /// Committed internal variables of viscoelastic elements, all Gauss points one after the
+    /// other (empty for elastic elements).
+    pub history: Vec<Vec<f64>>,
     /// For local pair (a, b): rank of min(node a, node b) among the upper neighbours of
     /// max(node a, node b) in the pattern.
     ranks: Vec<[[u32; N]; N]>,
@@ -32,6 +39,8 @@ impl<const N: usize, const G: usize> ElementBlock<N, G> {
             nodes: vec![],
             gauss: vec![],
             body: vec![],
+            fbar: vec![],
+            history: vec![],
             ranks: vec![],
             colours: vec![],
         }
@@ -73,6 +82,8 @@ pub struct Discretisation {
     pub tets: ElementBlock<4, 1>,
     /// Upper-triangle block pattern of every system matrix.
     pub pattern: BlockPattern,
+    /// Size of the step being solved [s], for the viscoelastic materials.
+    pub step_dt: f64,
 }
 
 /// Assembled internal force, tangent values (pattern order), energy and min J.
@@ -152,10 +163,56 @@ fn fill_ranks<const N: usize, const G: usize>(
     block.colours = colour_elements(&block.nodes, pattern.num_nodes);
 }
 
+/// Zeroed internal variables for an element of `points` Gauss points (empty if elastic).
+fn history_for(material: &dyn Hyperelastic, points: usize) -> Vec<f64> {
+    material
+        .viscoelastic()
+        .map_or(Vec::new(), |ve| vec![0.0; points * ve.history_len()])
+}
+
+fn commit_block<const N: usize, const G: usize>(
+    block: &mut ElementBlock<N, G>,
+    materials: &[Arc<dyn Hyperelastic>],
+    u: &[f64],
+    dt: f64,
+) {
+    let (nodes, gauss, body, fbar) = (&block.nodes, &block.gauss, &block.body, &block.fbar);
+    block
+        .history
+        .par_iter_mut()
+        .enumerate()
+        .filter(|(_, h)| !h.is_empty())
+        .for_each(|(e, h)| {
+            let Some(ve) = materials[body[e]].viscoelastic() else {
+                return;
+            };
+            let ue: [[f64; 3]; N] =
+                std::array::from_fn(|a| std::array::from_fn(|i| u[3 * nodes[e][a] + i]));
+            let cs = if fbar[e] {
+                fbar_gauss_point_c(&gauss[e], &ue)
+            } else {
+                gauss_point_c(&gauss[e], &ue)
+            };
+            let len = ve.history_len();
+            for (q, c) in cs.iter().enumerate() {
+                ve.commit(c, &mut h[q * len..(q + 1) * len], dt);
+            }
+        });
+}
+
 impl Discretisation {
     /// Builds the discretisation of the given bodies (mesh, material). Fails with the list
     /// of degenerate or inverted reference elements.
     pub fn new(bodies: &[(&Mesh, Arc<dyn Hyperelastic>)]) -> Result<Self, Vec<BadElement>> {
+        Self::with_formulations(bodies, &[])
+    }
+
+    /// As [`Discretisation::new`], with the element formulation of each body's hexahedra
+    /// (bodies beyond the end of `formulations` use the standard element).
+    pub fn with_formulations(
+        bodies: &[(&Mesh, Arc<dyn Hyperelastic>)],
+        formulations: &[Formulation],
+    ) -> Result<Self, Vec<BadElement>> {
         let mut node_offset = Vec::new();
         let mut reference = Vec::new();
         let mut hexes = ElementBlock::<8, 8>::empty();
@@ -165,6 +222,7 @@ impl Discretisation {
             let off = reference.len();
             node_offset.push(off);
             reference.extend_from_slice(&mesh.nodes);
+            let fbar = formulations.get(bi) == Some(&Formulation::FBar);
             for (ci, h) in mesh.hexes.iter().enumerate() {
                 let x = h.map(|n| mesh.nodes[n]);
                 match hex8_geometry(&x) {
@@ -172,6 +230,8 @@ impl Discretisation {
                         hexes.nodes.push(h.map(|n| n + off));
                         hexes.gauss.push(g);
                         hexes.body.push(bi);
+                        hexes.fbar.push(fbar);
+                        hexes.history.push(history_for(&*bodies[bi].1, 8));
                     }
                     Err(DegenerateElement { det }) => bad.push(BadElement {
                         body: bi,
@@ -187,6 +247,8 @@ impl Discretisation {
                         tets.nodes.push(t.map(|n| n + off));
                         tets.gauss.push(g);
                         tets.body.push(bi);
+                        tets.fbar.push(false);
+                        tets.history.push(history_for(&*bodies[bi].1, 1));
                     }
                     Err(DegenerateElement { det }) => bad.push(BadElement {
                         body: bi,
@@ -219,7 +281,58 @@ impl Discretisation {
             hexes,
             tets,
             pattern,
+            step_dt: 0.0,
         })
+    }
+
+    /// Sets the size Δt [s] of the step about to be solved (viscoelastic materials).
+    pub fn begin_step(&mut self, dt: f64) {
+        self.step_dt = dt;
+    }
+
+    /// Advances the internal variables of the viscoelastic elements to the converged
+    /// displacement `u` at the end of a step of the size last given to
+    /// [`Discretisation::begin_step`].
+    pub fn commit_step(&mut self, u: &[f64]) {
+        let dt = self.step_dt;
+        commit_block(&mut self.hexes, &self.materials, u, dt);
+        commit_block(&mut self.tets, &self.materials, u, dt);
+    }
+
+    /// All internal variables, elements in order (for checkpoints).
+    pub fn history(&self) -> Vec<f64> {
+        self.hexes
+            .history
+            .iter()
+            .chain(&self.tets.history)
+            .flatten()
+            .copied()
+            .collect()
+    }
+
+    /// Restores internal variables saved by [`Discretisation::history`]. Fails, changing
+    /// nothing, when the length does not fit.
+    pub fn set_history(&mut self, values: &[f64]) -> Result<(), String> {
+        let n: usize = self
+            .hexes
+            .history
+            .iter()
+            .chain(&self.tets.history)
+            .map(Vec::len)
+            .sum();
+        if values.len() != n {
+            return Err(format!(
+                "material history has {} values but the problem has {n}",
+                values.len()
+            ));
+        }
+        let mut k = 0;
+        for h in self.hexes.history.iter_mut().chain(&mut self.tets.history) {
+            let len = h.len();
+            h.copy_from_slice(&values[k..k + len]);
+            k += len;
+        }
+        Ok(())
     }
 
     /// Number of scalar unknowns (3 per node).
@@ -269,7 +382,19 @@ impl Discretisation {
                         [u[3 * n], u[3 * n + 1], u[3 * n + 2]]
                     });
                     let mat = &*self.materials[block.body[e]];
-                    let r = element_response(&block.gauss[e], &ue, mat, with_tangent);
+                    let hist = (!block.history[e].is_empty())
+                        .then(|| (&block.history[e][..], self.step_dt));
+                    let r = if block.fbar[e] {
+                        fbar_element_response_with_history(
+                            &block.gauss[e],
+                            &ue,
+                            mat,
+                            with_tangent,
+                            hist,
+                        )
+                    } else {
+                        element_response_with_history(&block.gauss[e], &ue, mat, with_tangent, hist)
+                    };
                     // SAFETY: elements of one colour share no node, so they write disjoint
                     // entries of the force vector and of the tangent values.
                     unsafe {

@@ -1,11 +1,11 @@
 //! Checkpoints: everything a run needs to continue bit for bit after it stopped.
 //!
 //! A checkpoint holds the stepper's [`Snapshot`] (time, step counter, u, v, the committed
-//! contact state, the current Δt and its cut-back bookkeeping, the energy accumulators and
-//! the forces at the start of the next step), how far the outputs got (frames written, the
-//! next frame time, the PVD entries, history rows) and the run's counters. It is tied to the
-//! problem it was written for by a fingerprint, so that resuming with a changed scenario is
-//! refused.
+//! contact state, the internal variables of viscoelastic materials, the current Δt and its
+//! cut-back bookkeeping, the energy accumulators and the forces at the start of the next
+//! step), how far the outputs got (frames written, the next frame time, the PVD entries,
+//! history rows) and the run's counters. It is tied to the problem it was written for by a
+//! fingerprint, so that resuming with a changed scenario is refused.
 //!
 //! File format (`DIR/checkpoint.bin`, little-endian): the magic `ADHCKPT\0`, a format
 //! version (u32), then length-prefixed fields (u64 counts, f64 bit patterns, UTF-8 strings),
@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 pub const FILE_NAME: &str = "checkpoint.bin";
 
 const MAGIC: &[u8; 8] = b"ADHCKPT\0";
-const FORMAT: u32 = 1;
+const FORMAT: u32 = 2;
 
 /// A run's state after a committed step.
 #[derive(Clone, Debug, PartialEq)]
@@ -173,6 +173,7 @@ impl Checkpoint {
             external_work,
             last_internal,
             contact,
+            material_history,
         } = &self.snapshot;
         w.f64(*t);
         w.usize(*step);
@@ -211,6 +212,7 @@ impl Checkpoint {
                 w.0.extend_from_slice(&state.to_le_bytes());
             }
         }
+        w.f64s(material_history);
         let FrameProgress {
             frames,
             next_time,
@@ -294,6 +296,7 @@ impl Checkpoint {
             }
             contact.push(nodes);
         }
+        let material_history = r.f64s()?;
         let frames = r.usize()?;
         let next_time = r.f64()?;
         let n_entries = r.len(16)?;
@@ -328,6 +331,7 @@ impl Checkpoint {
                 external_work,
                 last_internal,
                 contact,
+                material_history,
             },
             frames: FrameProgress {
                 frames,
@@ -439,6 +443,7 @@ mod tests {
                 external_work: 2.0,
                 last_internal: 1.0,
                 contact: vec![vec![c, NodeContact::default()], vec![]],
+                material_history: vec![0.25, -1e-9],
             },
             frames: FrameProgress {
                 frames: 3,

@@ -125,6 +125,13 @@ pub fn hex8_geometry(x: &[[f64; 3]; 8]) -> Result<[GaussPoint<8>; 8], Degenerate
     Ok(out)
 }
 
+/// Shape-function data at the centre (ξ = 0) of a hex8 with reference coordinates `x` [m],
+/// weight 8 (the natural volume), as the F-bar element needs.
+pub fn hex8_centre(x: &[[f64; 3]; 8]) -> Result<GaussPoint<8>, DegenerateElement> {
+    let (n, dn) = hex8_shape([0.0; 3]);
+    gauss_point(x, n, dn, 8.0)
+}
+
 /// Gauss-point data of a tet4 with reference coordinates `x` [m] (one point, weight 1/6).
 pub fn tet4_geometry(x: &[[f64; 3]; 4]) -> Result<[GaussPoint<4>; 1], DegenerateElement> {
     let (n, dn) = tet4_shape([0.25; 3]);
@@ -209,6 +216,20 @@ pub fn element_response<const N: usize, const G: usize>(
     material: &dyn Hyperelastic,
     with_tangent: bool,
 ) -> ElementResponse<N> {
+    element_response_with_history(gps, u, material, with_tangent, None)
+}
+
+/// As [`element_response`], for a viscoelastic material: `history` holds the committed
+/// internal variables of the element's Gauss points one after the other and the step size
+/// Δt [s] (`None`: elastic response).
+pub fn element_response_with_history<const N: usize, const G: usize>(
+    gps: &[GaussPoint<N>; G],
+    u: &[[f64; 3]; N],
+    material: &dyn Hyperelastic,
+    with_tangent: bool,
+    history: Option<(&[f64], f64)>,
+) -> ElementResponse<N> {
+    let viscous = history.zip(material.viscoelastic());
     let small = material.small_strain();
     let mut force = [[0.0; 3]; N];
     let mut tangent = if with_tangent {
@@ -218,7 +239,7 @@ pub fn element_response<const N: usize, const G: usize>(
     };
     let mut energy = 0.0;
     let mut min_j = f64::INFINITY;
-    for gp in gps {
+    for (q, gp) in gps.iter().enumerate() {
         let h = displacement_gradient(gp, u);
         let f = Mat3::identity() + h;
         let j = f.determinant();
@@ -235,12 +256,16 @@ pub fn element_response<const N: usize, const G: usize>(
         energy += material.energy(&c) * gp.weight;
         let w = gp.weight;
         let bs: [Bmat; N] = std::array::from_fn(|a| b_matrix(&fb, &gp.grad[a]));
-        let (s, d) = if with_tangent {
+        let (mut s, mut d) = if with_tangent {
             let (s, d) = material.pk2_and_tangent(&c);
             (s, Some(d))
         } else {
             (material.pk2(&c), None)
         };
+        if let Some(((hist, dt), ve)) = viscous {
+            let len = ve.history_len();
+            ve.add_viscous(&c, &hist[q * len..(q + 1) * len], dt, &mut s, d.as_mut());
+        }
         let sv = nalgebra::Vector6::new(
             s[(0, 0)],
             s[(1, 1)],
@@ -285,6 +310,17 @@ pub fn element_response<const N: usize, const G: usize>(
         energy,
         min_j,
     }
+}
+
+/// C = FᵀF at each Gauss point (finite strain).
+pub fn gauss_point_c<const N: usize, const G: usize>(
+    gps: &[GaussPoint<N>; G],
+    u: &[[f64; 3]; N],
+) -> [Mat3; G] {
+    std::array::from_fn(|q| {
+        let f = Mat3::identity() + displacement_gradient(&gps[q], u);
+        f.transpose() * f
+    })
 }
 
 /// Cauchy stress σ = J⁻¹ F S Fᵀ averaged over the Gauss points (volume-weighted) [Pa], and

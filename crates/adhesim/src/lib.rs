@@ -11,6 +11,7 @@ pub mod assembly;
 pub mod checkpoint;
 pub mod contact;
 pub mod element;
+pub mod fbar;
 pub mod linalg;
 pub mod material;
 pub mod mesh;

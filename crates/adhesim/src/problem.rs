@@ -116,6 +116,8 @@ pub struct Body {
     pub density: f64,
     /// Initial velocity [m/s] of every node.
     pub initial_velocity: [f64; 3],
+    /// Element kinematics of the body's hexahedra (standard or F-bar).
+    pub element: crate::fbar::Formulation,
 }
 
 /// Time integration settings (model.md §3).

@@ -96,6 +96,8 @@ struct FileBody {
     plane_strain: bool,
     #[serde(default)]
     offset: Option<[f64; 3]>,
+    #[serde(default)]
+    element: Option<String>,
 }
 
 /// `mesh = { generator = ..., ... }` (a built-in mesh) or `mesh = { file = ..., ... }` (a
@@ -199,6 +201,13 @@ struct FileMaterial {
     g: Option<f64>,
     young: Option<f64>,
     poisson: Option<f64>,
+    c10: Option<f64>,
+    c01: Option<f64>,
+    d1: Option<f64>,
+    kappa: Option<f64>,
+    mu: Option<Vec<f64>>,
+    alpha: Option<Vec<f64>>,
+    prony: Option<Vec<[f64; 2]>>,
 }
 
 #[derive(Deserialize, Debug, Clone)]
@@ -479,6 +488,22 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
         }
         let material = build_material(&b.material, &format!("{key}.material"), ctx)?;
         let density = ctx.positive(&format!("{key}.density"), b.density)?;
+        let element = match b.element.as_deref() {
+            None | Some("standard") => crate::fbar::Formulation::Standard,
+            Some("fbar") => {
+                if material.small_strain() {
+                    return Err(ctx.err(format!(
+                        "`{key}.element` = \"fbar\" needs a finite-strain material; \"linear-elastic\" uses linear kinematics"
+                    )));
+                }
+                crate::fbar::Formulation::FBar
+            }
+            Some(other) => {
+                return Err(ctx.err(format!(
+                    "`{key}.element` = {other:?}; valid values are \"standard\" (full integration) and \"fbar\" (locking-free hexahedra)"
+                )))
+            }
+        };
         let initial_velocity = ctx.finite3(
             &format!("{key}.initial_velocity"),
             b.initial_velocity.unwrap_or([0.0; 3]),
@@ -489,6 +514,7 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
             material,
             density,
             initial_velocity,
+            element,
         });
     }
     let offsets = {
@@ -1039,6 +1065,53 @@ fn build_material(
     key: &str,
     ctx: &Ctx,
 ) -> Result<Arc<dyn Hyperelastic>, ScenarioError> {
+    if matches!(
+        m.model.as_str(),
+        "uncoupled-neo-hookean" | "mooney-rivlin" | "ogden"
+    ) {
+        let elastic = build_uncoupled_material(m, key, ctx)?;
+        let Some(prony) = &m.prony else {
+            return Ok(elastic);
+        };
+        if prony.is_empty() || prony.len() > 12 {
+            return Err(ctx.err(format!(
+                "`{key}.prony` needs 1 to 12 terms [[g1, tau1], ...], got {}",
+                prony.len()
+            )));
+        }
+        let mut terms = Vec::new();
+        for (i, &[g, tau]) in prony.iter().enumerate() {
+            if !(g > 0.0 && g < 1.0) {
+                return Err(ctx.err(format!(
+                    "`{key}.prony[{i}]`: the relative modulus g must be in (0, 1), got {g}"
+                )));
+            }
+            ctx.positive(&format!("{key}.prony[{i}] (relaxation time tau [s])"), tau)?;
+            terms.push(material::PronyTerm { g, tau });
+        }
+        let total: f64 = terms.iter().map(|t| t.g).sum();
+        if total >= 1.0 {
+            return Err(ctx.err(format!(
+                "`{key}.prony`: the relative moduli add up to {total}; their sum must stay below 1 (the long-term shear modulus is μ (1 − Σ g))"
+            )));
+        }
+        return Ok(Arc::new(material::Viscoelastic { elastic, terms }));
+    }
+    let extra = [
+        ("c10", m.c10.is_some()),
+        ("c01", m.c01.is_some()),
+        ("d1", m.d1.is_some()),
+        ("kappa", m.kappa.is_some()),
+        ("mu", m.mu.is_some()),
+        ("alpha", m.alpha.is_some()),
+        ("prony", m.prony.is_some()),
+    ];
+    if let Some((name, _)) = extra.iter().find(|(_, given)| *given) {
+        return Err(ctx.err(format!(
+            "`{key}.{name}` is not used by model {:?}; it belongs to \"uncoupled-neo-hookean\", \"mooney-rivlin\" or \"ogden\"",
+            m.model
+        )));
+    }
     let young_poisson = || -> Result<(f64, f64), ScenarioError> {
         let e = m.young.ok_or_else(|| {
             ctx.err(format!(
@@ -1086,8 +1159,136 @@ fn build_material(
         }
         other => {
             return Err(ctx.err(format!(
-                "`{key}.model` = {other:?}; valid models are \"blatz-ko\", \"neo-hookean\", \"saint-venant-kirchhoff\", \"linear-elastic\""
+                "`{key}.model` = {other:?}; valid models are \"blatz-ko\", \"neo-hookean\", \"saint-venant-kirchhoff\", \"linear-elastic\", \"uncoupled-neo-hookean\", \"mooney-rivlin\", \"ogden\""
             )))
+        }
+    })
+}
+
+/// The nearly incompressible (uncoupled) models: the isochoric parameters and a bulk modulus,
+/// `kappa` [Pa] or the Abaqus `d1` [1/Pa] (κ = 2/D₁); the neo-Hookean one also accepts
+/// `young` and `poisson` (ν < ½).
+fn build_uncoupled_material(
+    m: &FileMaterial,
+    key: &str,
+    ctx: &Ctx,
+) -> Result<Arc<dyn Hyperelastic>, ScenarioError> {
+    let model = m.model.as_str();
+    let allowed: &[&str] = match model {
+        "uncoupled-neo-hookean" => &["c10", "kappa", "d1", "young", "poisson"],
+        "mooney-rivlin" => &["c10", "c01", "kappa", "d1"],
+        _ => &["mu", "alpha", "kappa", "d1"],
+    };
+    let given = [
+        ("g", m.g.is_some()),
+        ("young", m.young.is_some()),
+        ("poisson", m.poisson.is_some()),
+        ("c10", m.c10.is_some()),
+        ("c01", m.c01.is_some()),
+        ("d1", m.d1.is_some()),
+        ("kappa", m.kappa.is_some()),
+        ("mu", m.mu.is_some()),
+        ("alpha", m.alpha.is_some()),
+    ];
+    if let Some((name, _)) = given.iter().find(|(name, g)| *g && !allowed.contains(name)) {
+        return Err(ctx.err(format!(
+            "`{key}.{name}` is not used by model {model:?}; its keys are {}",
+            allowed.join(", ")
+        )));
+    }
+    let bulk = |required: bool| -> Result<Option<f64>, ScenarioError> {
+        match (m.kappa, m.d1) {
+            (Some(_), Some(_)) => Err(ctx.err(format!(
+                "`{key}`: give the bulk modulus either as `kappa` [Pa] or as `d1` [1/Pa] (κ = 2/D1), not both"
+            ))),
+            (Some(k), None) => Ok(Some(ctx.positive(&format!("{key}.kappa"), k)?)),
+            (None, Some(d1)) => Ok(Some(material::bulk_from_d1(
+                ctx.positive(&format!("{key}.d1"), d1)?,
+            ))),
+            (None, None) if required => Err(ctx.err(format!(
+                "`{key}` with model {model:?} needs a bulk modulus: `kappa` [Pa] or `d1` [1/Pa] (κ = 2/D1)"
+            ))),
+            (None, None) => Ok(None),
+        }
+    };
+    let need = |v: Option<f64>, name: &str| -> Result<f64, ScenarioError> {
+        let v = v.ok_or_else(|| {
+            ctx.err(format!(
+                "`{key}` with model {model:?} needs `{name}` [Pa]; its keys are {}",
+                allowed.join(", ")
+            ))
+        })?;
+        ctx.finite(&format!("{key}.{name}"), v)
+    };
+    Ok(match model {
+        "uncoupled-neo-hookean" => {
+            if m.young.is_some() || m.poisson.is_some() {
+                if m.c10.is_some() || m.kappa.is_some() || m.d1.is_some() {
+                    return Err(ctx.err(format!(
+                        "`{key}`: give either `young` and `poisson`, or `c10` and `kappa` (or `d1`), not both"
+                    )));
+                }
+                let e = ctx.positive(&format!("{key}.young"), need(m.young, "young")?)?;
+                let nu = m
+                    .poisson
+                    .ok_or_else(|| ctx.err(format!("`{key}` with `young` needs `poisson` too")))?;
+                if !(nu > -1.0 && nu < 0.5) {
+                    return Err(ctx.err(format!(
+                        "`{key}.poisson` must be in (−1, 0.5), got {nu}; for incompressibility use e.g. 0.4999"
+                    )));
+                }
+                Arc::new(material::UncoupledNeoHookean::from_young_poisson(e, nu))
+            } else {
+                let c10 = ctx.positive(&format!("{key}.c10"), need(m.c10, "c10")?)?;
+                let kappa = bulk(true)?.unwrap_or(0.0);
+                Arc::new(material::UncoupledNeoHookean { c10, kappa })
+            }
+        }
+        "mooney-rivlin" => {
+            let c10 = need(m.c10, "c10")?;
+            let c01 = m
+                .c01
+                .map_or(Ok(0.0), |v| ctx.finite(&format!("{key}.c01"), v))?;
+            if c10 + c01 <= 0.0 {
+                return Err(ctx.err(format!(
+                    "`{key}`: the shear modulus 2 (c10 + c01) must be positive, got c10 = {c10}, c01 = {c01}"
+                )));
+            }
+            let kappa = bulk(true)?.unwrap_or(0.0);
+            Arc::new(material::MooneyRivlin { c10, c01, kappa })
+        }
+        _ => {
+            let (mu, alpha) = match (&m.mu, &m.alpha) {
+                (Some(mu), Some(alpha)) => (mu.clone(), alpha.clone()),
+                _ => {
+                    return Err(ctx.err(format!(
+                        "`{key}` with model \"ogden\" needs `mu = [μ1, ...]` [Pa] and `alpha = [α1, ...]` of the same length"
+                    )))
+                }
+            };
+            if mu.is_empty() || mu.len() != alpha.len() || mu.len() > 6 {
+                return Err(ctx.err(format!(
+                    "`{key}.mu` and `{key}.alpha` must have the same length, 1 to 6 terms; got {} and {}",
+                    mu.len(),
+                    alpha.len()
+                )));
+            }
+            for (i, (&mi, &ai)) in mu.iter().zip(&alpha).enumerate() {
+                ctx.finite(&format!("{key}.mu[{i}]"), mi)?;
+                if !ai.is_finite() || ai == 0.0 {
+                    return Err(ctx.err(format!(
+                        "`{key}.alpha[{i}]` must be a finite non-zero number, got {ai}"
+                    )));
+                }
+                if mi * ai <= 0.0 {
+                    return Err(ctx.err(format!(
+                        "`{key}`: term {i} has μ·α = {} ≤ 0; each term needs μᵢαᵢ > 0 to be stable in the small-strain limit",
+                        mi * ai
+                    )));
+                }
+            }
+            let kappa = bulk(true)?.unwrap_or(0.0);
+            Arc::new(material::Ogden { mu, alpha, kappa })
         }
     })
 }

@@ -163,6 +163,9 @@ pub struct Snapshot {
     pub last_internal: f64,
     /// Committed contact state per pair and slave node.
     pub contact: Vec<Vec<NodeContact>>,
+    /// Internal variables of the viscoelastic materials (see
+    /// [`Discretisation::history`]).
+    pub material_history: Vec<f64>,
 }
 
 /// Advances a [`Problem`] in time.
@@ -217,7 +220,9 @@ impl Stepper {
             .iter()
             .map(|b| (&b.mesh, b.material.clone()))
             .collect();
-        let disc = Discretisation::new(&bodies).map_err(SetupError::BadElements)?;
+        let formulations: Vec<_> = problem.bodies.iter().map(|b| b.element).collect();
+        let disc = Discretisation::with_formulations(&bodies, &formulations)
+            .map_err(SetupError::BadElements)?;
         let density: Vec<f64> = problem.bodies.iter().map(|b| b.density).collect();
         let mass = disc.mass(&density, problem.time.lumped_mass);
         let n = disc.num_dofs();
@@ -351,6 +356,7 @@ impl Stepper {
             external_work: self.external_work,
             last_internal: self.last_internal,
             contact: self.contact.clone(),
+            material_history: self.disc.history(),
         }
     }
 
@@ -380,6 +386,7 @@ impl Stepper {
         if !(snap.dt > 0.0) || !snap.t.is_finite() {
             return Err(format!("invalid time {} or step size {}", snap.t, snap.dt));
         }
+        self.disc.set_history(&snap.material_history)?;
         self.state = State {
             t: snap.t,
             u: snap.u,
@@ -530,6 +537,7 @@ impl Stepper {
     }
 
     fn commit(&mut self, u: Vec<f64>, v: Vec<f64>, dt: f64) {
+        self.disc.commit_step(&u);
         self.state.u = u;
         self.state.v = v;
         self.state.t += dt;
@@ -567,6 +575,7 @@ impl Stepper {
 
     /// One Newton solve over [t, t+dt]; Err with the reason on failure.
     fn attempt(&mut self, dt: f64) -> Result<Attempt, String> {
+        self.disc.begin_step(dt);
         let ts = self.problem.time.clone();
         let (theta, xi, qs) = (ts.theta, ts.xi, ts.quasi_static);
         let newton_contact = ts.contact_solver == ContactSolver::Newton;

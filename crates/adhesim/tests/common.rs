@@ -50,6 +50,7 @@ pub fn one_body(
             material,
             density,
             initial_velocity: [0.0; 3],
+            element: Default::default(),
         }],
         dirichlet: vec![],
         loads: vec![],

@@ -2,8 +2,14 @@
 //! central finite differences on a distorted hex8 and a tet4, at large random displacements,
 //! for every material.
 
-use adhesim::element::{element_response, hex8_geometry, tet4_geometry, GaussPoint};
-use adhesim::material::{BlatzKo, Hyperelastic, LinearElastic, NeoHookean, SaintVenantKirchhoff};
+use adhesim::element::{
+    element_response, hex8_geometry, tet4_geometry, ElementResponse, GaussPoint,
+};
+use adhesim::fbar::fbar_element_response;
+use adhesim::material::{
+    BlatzKo, Hyperelastic, LinearElastic, MooneyRivlin, NeoHookean, Ogden, SaintVenantKirchhoff,
+    UncoupledNeoHookean,
+};
 
 mod common;
 use common::Rng;
@@ -14,6 +20,17 @@ fn materials() -> Vec<Box<dyn Hyperelastic>> {
         Box::new(NeoHookean::from_young_poisson(2.0e6, 0.3)),
         Box::new(SaintVenantKirchhoff::from_young_poisson(2.0e6, 0.3)),
         Box::new(LinearElastic::from_young_poisson(2.0e6, 0.3)),
+        Box::new(UncoupledNeoHookean::from_young_poisson(2.0e6, 0.45)),
+        Box::new(MooneyRivlin {
+            c10: 0.3e6,
+            c01: 0.1e6,
+            kappa: 2.0e7,
+        }),
+        Box::new(Ogden {
+            mu: vec![0.4e6, 0.01e6],
+            alpha: vec![1.3, -2.0],
+            kappa: 2.0e7,
+        }),
     ]
 }
 
@@ -23,7 +40,16 @@ fn check<const N: usize, const G: usize>(
     u: &[[f64; 3]; N],
     mat: &dyn Hyperelastic,
 ) -> (f64, f64) {
-    let r = element_response(gps, u, mat, true);
+    check_kernel(|u, t| element_response(gps, u, mat, t), u, mat)
+}
+
+/// As [`check`] for any element kernel `response(u, with_tangent)`.
+fn check_kernel<const N: usize>(
+    response: impl Fn(&[[f64; 3]; N], bool) -> ElementResponse<N>,
+    u: &[[f64; 3]; N],
+    mat: &dyn Hyperelastic,
+) -> (f64, f64) {
+    let r = response(u, true);
     let k = r.tangent.unwrap();
     let kmax = (0..N)
         .flat_map(|a| (0..N).map(move |b| (a, b)))
@@ -44,8 +70,8 @@ fn check<const N: usize, const G: usize>(
             let mut um = *u;
             up[b][kk] += h;
             um[b][kk] -= h;
-            let rp = element_response(gps, &up, mat, false);
-            let rm = element_response(gps, &um, mat, false);
+            let rp = response(&up, false);
+            let rm = response(&um, false);
             for a in 0..N {
                 for i in 0..3 {
                     let fd = (rp.force[a][i] - rm.force[a][i]) / (2.0 * h);
@@ -87,6 +113,62 @@ fn hex8_tangent_matches_finite_differences_of_the_internal_force() {
             );
         }
     }
+}
+
+#[test]
+fn fbar_hex8_tangent_matches_finite_differences_of_the_internal_force() {
+    // The F-bar tangent couples all 8 nodes through the element's volume ratio θ: the full
+    // 24×24 matrix is compared, and the force against FD of the element energy Σ w W(F̄).
+    let mut rng = Rng(0x51ed_2701_b00c_fa1e);
+    let s = 0.01;
+    for trial in 0..5 {
+        let x: [[f64; 3]; 8] = std::array::from_fn(|a| {
+            let c = adhesim::element::HEX_NODE_XI[a];
+            std::array::from_fn(|k| s * (0.5 * (c[k] + 1.0) + 0.15 * rng.next()))
+        });
+        let gps = hex8_geometry(&x).expect("valid distorted hex");
+        let u: [[f64; 3]; 8] =
+            std::array::from_fn(|_| std::array::from_fn(|_| 0.2 * s * rng.next()));
+        for mat in materials() {
+            let m = mat.as_ref();
+            let (ek, ef) = check_kernel(|u, t| fbar_element_response(&gps, u, m, t), &u, m);
+            // Same tolerance and reasoning as for the standard hex8.
+            assert!(
+                ek < 1e-6,
+                "trial {trial} {mat:?}: F-bar tangent error {ek:e}"
+            );
+            assert!(
+                ef < 1e-6,
+                "trial {trial} {mat:?}: F-bar force vs energy {ef:e}"
+            );
+        }
+    }
+}
+
+#[test]
+fn fbar_of_a_homogeneous_deformation_is_the_standard_element() {
+    // Under a homogeneous F every point has J = θ, so F̄ = F: forces must coincide.
+    let s = 0.01;
+    let x: [[f64; 3]; 8] =
+        std::array::from_fn(|a| adhesim::element::HEX_NODE_XI[a].map(|c| 0.5 * s * (c + 1.0)));
+    let gps = hex8_geometry(&x).unwrap();
+    let h = [[0.1, 0.05, -0.02], [0.03, -0.08, 0.04], [0.0, 0.02, 0.12]];
+    let u: [[f64; 3]; 8] =
+        std::array::from_fn(|a| std::array::from_fn(|i| (0..3).map(|k| h[i][k] * x[a][k]).sum()));
+    let mat = UncoupledNeoHookean::from_young_poisson(1.0e6, 0.4999);
+    let r1 = element_response(&gps, &u, &mat, false);
+    let r2 = fbar_element_response(&gps, &u, &mat, false);
+    let fmax = r1
+        .force
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    for a in 0..8 {
+        for i in 0..3 {
+            assert!((r1.force[a][i] - r2.force[a][i]).abs() < 1e-10 * fmax);
+        }
+    }
+    assert!((r1.energy - r2.energy).abs() < 1e-10 * r1.energy);
 }
 
 #[test]

@@ -25,19 +25,38 @@ pub trait Hyperelastic: Send + Sync + std::fmt::Debug {
     fn shear_modulus(&self) -> f64;
     /// Small-strain bulk modulus [Pa], for wave-speed and time-step estimates.
     fn bulk_modulus(&self) -> f64;
+    /// The isochoric part (S_iso, D_iso) of S and D, for materials with a volumetric/isochoric
+    /// split (`None` otherwise).
+    fn isochoric_pk2_and_tangent(&self, _c: &Mat3) -> Option<(Mat3, Mat6)> {
+        None
+    }
+    /// The viscoelastic model, for materials with internal variables (`None`: elastic).
+    fn viscoelastic(&self) -> Option<&Viscoelastic> {
+        None
+    }
 }
 
 mod blatz_ko;
 mod linear_elastic;
+mod mooney_rivlin;
 mod neo_hookean;
+mod ogden;
 mod saint_venant_kirchhoff;
 #[cfg(test)]
 mod test_support;
+mod uncoupled;
+mod uncoupled_neo_hookean;
+mod viscoelastic;
 
 pub use blatz_ko::BlatzKo;
 pub use linear_elastic::LinearElastic;
+pub use mooney_rivlin::MooneyRivlin;
 pub use neo_hookean::NeoHookean;
+pub use ogden::Ogden;
 pub use saint_venant_kirchhoff::SaintVenantKirchhoff;
+pub use uncoupled::bulk_from_d1;
+pub use uncoupled_neo_hookean::UncoupledNeoHookean;
+pub use viscoelastic::{PronyTerm, Viscoelastic};
 
 /// Tensor index pairs (i, j) of the six Voigt components, in the order (11, 22, 33, 12, 23, 13).
 pub const VOIGT_PAIRS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2)];

@@ -170,7 +170,11 @@ fn body_frames(view: &StepView) -> Vec<BodyFrame> {
         for e in 0..disc.hexes.len() {
             if disc.hexes.body[e] == bi {
                 let ue = disc.hexes.nodes[e].map(|n| [u[3 * n], u[3 * n + 1], u[3 * n + 2]]);
-                let (s, j) = element_cauchy_stress(&disc.hexes.gauss[e], &ue, mat);
+                let (s, j) = if disc.hexes.fbar[e] {
+                    crate::fbar::fbar_cauchy_stress(&disc.hexes.gauss[e], &ue, mat)
+                } else {
+                    element_cauchy_stress(&disc.hexes.gauss[e], &ue, mat)
+                };
                 push(s, j);
             }
         }

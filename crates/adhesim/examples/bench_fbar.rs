@@ -1,0 +1,106 @@
+//! Cost of the F-bar hex8 against the standard fully integrated hex8, on an n³ cube of the
+//! nearly incompressible neo-Hookean solid (E = 1 MPa, ν = 0.4999) deformed by a smooth
+//! finite displacement field:
+//!
+//! 1. one element's `element_response` / `fbar_element_response` with tangent (µs);
+//! 2. `Discretisation::assemble(u, true)` on one thread, per element (µs).
+//!
+//! Each timing: one warm-up run, then `reps` runs; the median is reported with the ratio
+//! F-bar / standard. Usage: `cargo run --release --example bench_fbar -- [n] [reps]`.
+
+use adhesim::assembly::Discretisation;
+use adhesim::element::{element_response, hex8_geometry};
+use adhesim::fbar::{fbar_element_response, Formulation};
+use adhesim::material::{Hyperelastic, UncoupledNeoHookean};
+use adhesim::mesh::generate;
+use std::f64::consts::PI;
+use std::hint::black_box;
+use std::sync::Arc;
+use std::time::Instant;
+
+fn displacement(x: [f64; 3]) -> [f64; 3] {
+    let s = (PI * x[0]).sin() * (PI * x[1]).sin() * (PI * x[2]).sin();
+    [
+        0.05 * x[0] + 0.03 * x[1] + 0.01 * s,
+        -0.025 * x[1] + 0.02 * x[2] + 0.005 * s,
+        0.01 * x[0] - 0.025 * x[2] - 0.008 * s,
+    ]
+}
+
+fn median(reps: usize, mut f: impl FnMut()) -> f64 {
+    f();
+    let mut t: Vec<f64> = (0..reps)
+        .map(|_| {
+            let t0 = Instant::now();
+            f();
+            t0.elapsed().as_secs_f64()
+        })
+        .collect();
+    t.sort_by(f64::total_cmp);
+    t[reps / 2]
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let n: usize = args.first().and_then(|s| s.parse().ok()).unwrap_or(30);
+    let reps: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(7);
+    let material: Arc<dyn Hyperelastic> =
+        Arc::new(UncoupledNeoHookean::from_young_poisson(1.0e6, 0.4999));
+
+    // 1. One element.
+    let h = 0.05;
+    let x: [[f64; 3]; 8] = std::array::from_fn(|a| {
+        let xi = adhesim::element::HEX_NODE_XI[a];
+        std::array::from_fn(|k| 0.4 + 0.5 * h * (xi[k] + 1.0))
+    });
+    let gps = hex8_geometry(&x).expect("valid element");
+    let ue: [[f64; 3]; 8] = std::array::from_fn(|a| displacement(x[a]));
+    let iters = 20_000;
+    let mat = &*material;
+    let standard_el = median(reps, || {
+        for _ in 0..iters {
+            black_box(element_response(black_box(&gps), black_box(&ue), mat, true));
+        }
+    }) / iters as f64;
+    let fbar_el = median(reps, || {
+        for _ in 0..iters {
+            black_box(fbar_element_response(
+                black_box(&gps),
+                black_box(&ue),
+                mat,
+                true,
+            ));
+        }
+    }) / iters as f64;
+
+    // 2. Assembly of an n³ cube on one thread.
+    let mesh = generate::block([1.0, 1.0, 1.0], [n, n, n]);
+    let u: Vec<f64> = mesh.nodes.iter().flat_map(|&p| displacement(p)).collect();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("thread pool");
+    let assemble = |f: Formulation| {
+        let disc = Discretisation::with_formulations(&[(&mesh, material.clone())], &[f])
+            .expect("valid mesh");
+        pool.install(|| median(reps, || drop(black_box(disc.assemble(black_box(&u), true)))))
+            / mesh.hexes.len() as f64
+    };
+    let standard_asm = assemble(Formulation::Standard);
+    let fbar_asm = assemble(Formulation::FBar);
+
+    println!("| measurement | standard hex8 [µs] | F-bar hex8 [µs] | ratio |");
+    println!("|---|---|---|---|");
+    println!(
+        "| element response with tangent | {:.2} | {:.2} | {:.2} |",
+        standard_el * 1e6,
+        fbar_el * 1e6,
+        fbar_el / standard_el
+    );
+    println!(
+        "| assembly K + f per element, {n}³ cube, 1 thread | {:.2} | {:.2} | {:.2} |",
+        standard_asm * 1e6,
+        fbar_asm * 1e6,
+        fbar_asm / standard_asm
+    );
+}

@@ -1,0 +1,168 @@
+//! Nearly incompressible Mooney-Rivlin material (uncoupled form).
+
+use super::uncoupled::{self, Isochoric, Tensor4};
+use super::Hyperelastic;
+use crate::{Mat3, Mat6};
+
+/// Mooney-Rivlin with a volumetric/isochoric split, as in Abaqus and FEBio:
+///
+/// W = C₁₀ (Ī₁ − 3) + C₀₁ (Ī₂ − 3) + κ/2 (J − 1)²,
+///
+/// Ī₁ = tr C̄, Ī₂ = ½ (Ī₁² − tr C̄²), C̄ = J^(−2/3) C. Small-strain shear modulus
+/// μ = 2 (C₁₀ + C₀₁), bulk modulus κ (Abaqus: κ = 2/D₁). C₀₁ = 0 is the uncoupled
+/// neo-Hookean solid ([`UncoupledNeoHookean`](super::UncoupledNeoHookean)).
+///
+/// Fictitious stress and elasticity: S̄ = 2 C₁₀ I + 2 C₀₁ (Ī₁ I − C̄),
+/// ℂ̄ = 4 C₀₁ (I⊗I − 𝕀) with 𝕀_ijkl = ½ (δ_ik δ_jl + δ_il δ_jk).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MooneyRivlin {
+    /// C₁₀ [Pa].
+    pub c10: f64,
+    /// C₀₁ [Pa].
+    pub c01: f64,
+    /// Bulk modulus κ [Pa].
+    pub kappa: f64,
+}
+
+impl Isochoric for MooneyRivlin {
+    fn iso_energy(&self, cbar: &Mat3) -> f64 {
+        let i1 = cbar.trace();
+        let i2 = 0.5 * (i1 * i1 - (cbar * cbar).trace());
+        self.c10 * (i1 - 3.0) + self.c01 * (i2 - 3.0)
+    }
+
+    fn iso_stress(&self, cbar: &Mat3) -> Mat3 {
+        let i1 = cbar.trace();
+        Mat3::identity() * (2.0 * self.c10 + 2.0 * self.c01 * i1) - cbar * (2.0 * self.c01)
+    }
+
+    fn iso_stress_and_tangent(&self, cbar: &Mat3) -> (Mat3, Option<Tensor4>) {
+        let s = self.iso_stress(cbar);
+        if self.c01 == 0.0 {
+            return (s, None);
+        }
+        let delta = |a: usize, b: usize| if a == b { 1.0 } else { 0.0 };
+        let mut t = [[0.0; 9]; 9];
+        for (p, row) in t.iter_mut().enumerate() {
+            let (i, j) = (p / 3, p % 3);
+            for (q, v) in row.iter_mut().enumerate() {
+                let (k, l) = (q / 3, q % 3);
+                let sym = 0.5 * (delta(i, k) * delta(j, l) + delta(i, l) * delta(j, k));
+                *v = 4.0 * self.c01 * (delta(i, j) * delta(k, l) - sym);
+            }
+        }
+        (s, Some(t))
+    }
+}
+
+impl Hyperelastic for MooneyRivlin {
+    /// W [J/m³]; +∞ when det C ≤ 0 (or is NaN).
+    fn energy(&self, c: &Mat3) -> f64 {
+        uncoupled::energy(self, self.kappa, c)
+    }
+
+    fn pk2(&self, c: &Mat3) -> Mat3 {
+        uncoupled::pk2(self, self.kappa, c)
+    }
+
+    fn pk2_and_tangent(&self, c: &Mat3) -> (Mat3, Mat6) {
+        uncoupled::pk2_and_tangent(self, self.kappa, c)
+    }
+
+    fn shear_modulus(&self) -> f64 {
+        2.0 * (self.c10 + self.c01)
+    }
+
+    fn bulk_modulus(&self) -> f64 {
+        self.kappa
+    }
+
+    fn isochoric_pk2_and_tangent(&self, c: &Mat3) -> Option<(Mat3, Mat6)> {
+        Some(uncoupled::pk2_and_tangent(self, 0.0, c))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_support::*;
+    use super::*;
+
+    /// A rubber with a strong second invariant term and ν ≈ 0.4999 (κ/μ = 5000).
+    fn material() -> MooneyRivlin {
+        MooneyRivlin {
+            c10: 0.3e6,
+            c01: 0.2e6,
+            kappa: 5.0e9,
+        }
+    }
+
+    #[test]
+    fn stress_matches_fd_of_energy() {
+        check_stress_fd(&material(), 41);
+        // A moderately compressible one, where the isochoric part is not drowned by κ.
+        check_stress_fd(
+            &MooneyRivlin {
+                kappa: 1.0e6,
+                ..material()
+            },
+            42,
+        );
+    }
+
+    #[test]
+    fn tangent_matches_fd_of_stress() {
+        check_tangent_fd(&material(), 43);
+        check_tangent_fd(
+            &MooneyRivlin {
+                kappa: 1.0e6,
+                ..material()
+            },
+            44,
+        );
+    }
+
+    #[test]
+    fn reference_state_is_stress_free() {
+        check_reference_state(&material());
+    }
+
+    #[test]
+    fn small_strain_limit_is_isotropic_elasticity() {
+        let m = material();
+        let mu = 2.0 * (m.c10 + m.c01);
+        check_small_strain_limit(&m, mu, m.kappa - 2.0 * mu / 3.0);
+    }
+
+    #[test]
+    fn isotropic() {
+        check_objectivity(&material(), 45);
+    }
+
+    #[test]
+    fn degenerate_inputs_do_not_panic() {
+        check_degenerate_inputs(&material());
+    }
+
+    #[test]
+    fn incompressible_uniaxial_stress_matches_the_closed_form() {
+        // Isochoric uniaxial stretch λ: Cauchy σ = 2 (λ² − 1/λ)(C₁₀ + C₀₁/λ) (Rivlin), the
+        // lateral stress being zero once the pressure is eliminated: σ₁₁ − σ₂₂ of the model
+        // must match, the volumetric part adding the same pressure to both.
+        let m = material();
+        for lambda in [0.6, 0.9, 1.3, 2.0] {
+            let f = Mat3::from_diagonal(&nalgebra::Vector3::new(
+                lambda,
+                lambda.powf(-0.5),
+                lambda.powf(-0.5),
+            ));
+            let s = m.pk2(&(f.transpose() * f));
+            let sigma = f * s * f.transpose();
+            let expected = 2.0 * (lambda * lambda - 1.0 / lambda) * (m.c10 + m.c01 / lambda);
+            let got = sigma[(0, 0)] - sigma[(1, 1)];
+            assert!(
+                (got - expected).abs() < 1e-9 * expected.abs(),
+                "{got} vs {expected}"
+            );
+        }
+    }
+}
