@@ -47,7 +47,9 @@ pub struct FrameWriter {
 }
 
 impl FrameWriter {
-    /// Frames go to `DIR/vtu/<name>_NNNNN.vtu`, the collection to `DIR/<name>.pvd`.
+    /// Frame `NNNNN` is the multiblock file `DIR/vtu/<name>_NNNNN.vtm` over one grid per body,
+    /// `DIR/vtu/<name>_NNNNN_body<i>.vtu`, and one per contact pair,
+    /// `DIR/vtu/<name>_NNNNN_contact<j>.vtu`; the collection over time is `DIR/<name>.pvd`.
     pub fn new(dir: &Path, name: &str, interval: f64) -> io::Result<Self> {
         std::fs::create_dir_all(dir.join("vtu"))?;
         let pvd = vtk::PvdWriter::new(dir.join(format!("{name}.pvd")))?;
@@ -90,11 +92,7 @@ impl FrameWriter {
         for entry in std::fs::read_dir(&vtu)? {
             let file = entry?.file_name();
             let Some(file) = file.to_str() else { continue };
-            let index = file
-                .strip_prefix(&prefix)
-                .and_then(|r| r.strip_suffix(".vtu"))
-                .filter(|r| r.len() >= 5 && r.bytes().all(|b| b.is_ascii_digit()))
-                .and_then(|r| r.parse::<usize>().ok());
+            let index = file.strip_prefix(&prefix).and_then(frame_file_index);
             if index.is_some_and(|i| i >= progress.frames) {
                 std::fs::remove_file(vtu.join(file))?;
             }
@@ -122,6 +120,22 @@ pub struct FrameProgress {
     pub entries: Vec<vtk::PvdEntry>,
 }
 
+/// The frame number of a file name with the `<name>_` prefix removed: `NNNNN.vtm`,
+/// `NNNNN.vtu` (single-file frames of earlier versions) or `NNNNN_<block>.vtu`, with at least
+/// five digits; `None` for any other name.
+fn frame_file_index(rest: &str) -> Option<usize> {
+    let digits = rest.bytes().take_while(u8::is_ascii_digit).count();
+    let (number, tail) = rest.split_at(digits);
+    let known = tail == ".vtm"
+        || tail == ".vtu"
+        || (tail.starts_with('_') && tail.len() > 5 && tail.ends_with(".vtu"));
+    if digits >= 5 && known {
+        number.parse().ok()
+    } else {
+        None
+    }
+}
+
 /// Per-body arrays of one frame.
 struct BodyFrame {
     points: Vec<[f64; 3]>,
@@ -132,6 +146,8 @@ struct BodyFrame {
     cauchy: Vec<[f64; 9]>,
     mises: Vec<f64>,
     jac: Vec<f64>,
+    node_id: Vec<i32>,
+    body_id: Vec<i32>,
 }
 
 fn body_frames(view: &StepView) -> Vec<BodyFrame> {
@@ -160,6 +176,8 @@ fn body_frames(view: &StepView) -> Vec<BodyFrame> {
             cauchy: Vec::new(),
             mises: Vec::new(),
             jac: Vec::new(),
+            node_id: (0..nn).map(|i| id_i32(off + i)).collect(),
+            body_id: vec![id_i32(bi); body.mesh.num_cells()],
         };
         let mat = &*disc.materials[bi];
         let mut push = |s: crate::Mat3, j: f64| {
@@ -200,61 +218,107 @@ impl Observer for FrameWriter {
                 f64::INFINITY
             };
         }
-        let frames = body_frames(view);
-        let pieces: Vec<vtk::Piece> = frames
-            .iter()
-            .map(|f| {
-                let mut p = vtk::Piece::new(&f.points);
-                if !f.hex_conn.is_empty() {
-                    p = p.with_cells(vtk::CellKind::Hex8, &f.hex_conn);
-                }
-                if !f.tet_conn.is_empty() {
-                    p = p.with_cells(vtk::CellKind::Tet4, &f.tet_conn);
-                }
-                p.with_point_data("u", vtk::FieldData::Vector(&f.u))
-                    .with_point_data("v", vtk::FieldData::Vector(&f.v))
-                    .with_cell_data("cauchy", vtk::FieldData::Tensor(&f.cauchy))
-                    .with_cell_data("von_mises", vtk::FieldData::Scalar(&f.mises))
-                    .with_cell_data("J", vtk::FieldData::Scalar(&f.jac))
-            })
-            .collect();
-        let surfaces: Vec<ContactFrame> = view
-            .problem
-            .contacts
-            .iter()
-            .zip(view.contact)
-            .map(|(pair, nodes)| contact_frame(pair, nodes, view))
-            .collect();
-        let mut pieces = pieces;
-        for c in &surfaces {
-            pieces.push(
-                vtk::Piece::new(&c.points)
-                    .with_cells(vtk::CellKind::Vertex, &c.vertices)
-                    .with_point_data("beta", vtk::FieldData::Scalar(&c.beta))
-                    .with_point_data("rn", vtk::FieldData::Scalar(&c.rn))
-                    .with_point_data("rn_dry", vtk::FieldData::Scalar(&c.rn_dry))
-                    .with_point_data("rn_adh", vtk::FieldData::Scalar(&c.rn_adh))
-                    .with_point_data("rt", vtk::FieldData::Vector(&c.rt))
-                    .with_point_data("rt_adh", vtk::FieldData::Vector(&c.rt_adh))
-                    .with_point_data("contact_force", vtk::FieldData::Vector(&c.force))
-                    .with_point_data("gap", vtk::FieldData::Scalar(&c.gap))
-                    .with_point_data("slip", vtk::FieldData::Scalar(&c.slip))
-                    .with_point_data("ut", vtk::FieldData::Vector(&c.ut))
-                    .with_point_data("state", vtk::FieldData::Int(&c.state)),
-            );
+        let stem = format!("{}_{:05}", self.name, self.frames);
+        let mut bodies = Vec::new();
+        for (i, f) in body_frames(view).iter().enumerate() {
+            let mut p = vtk::Piece::new(&f.points);
+            if !f.hex_conn.is_empty() {
+                p = p.with_cells(vtk::CellKind::Hex8, &f.hex_conn);
+            }
+            if !f.tet_conn.is_empty() {
+                p = p.with_cells(vtk::CellKind::Tet4, &f.tet_conn);
+            }
+            let p = p
+                .with_point_data("u", vtk::FieldData::Vector(&f.u))
+                .with_point_data("v", vtk::FieldData::Vector(&f.v))
+                .with_point_data("node_id", vtk::FieldData::Int(&f.node_id))
+                .with_cell_data("cauchy", vtk::FieldData::Tensor(&f.cauchy))
+                .with_cell_data("von_mises", vtk::FieldData::Scalar(&f.mises))
+                .with_cell_data("J", vtk::FieldData::Scalar(&f.jac))
+                .with_cell_data("body_id", vtk::FieldData::Int(&f.body_id));
+            let file = format!("{stem}_body{i}.vtu");
+            vtk::write_vtu(&self.dir.join("vtu").join(&file), &[p])?;
+            bodies.push((view.problem.bodies[i].name.clone(), file));
         }
-        let rel = format!("vtu/{}_{:05}.vtu", self.name, self.frames);
-        vtk::write_vtu(&self.dir.join(&rel), &pieces)?;
+        let mut contacts = Vec::new();
+        for (j, (pair, nodes)) in view.problem.contacts.iter().zip(view.contact).enumerate() {
+            let c = contact_frame(j, pair, nodes, view);
+            let mut p = vtk::Piece::new(&c.points);
+            if !c.quads.is_empty() {
+                p = p.with_cells(vtk::CellKind::Quad4, &c.quads);
+            }
+            if !c.triangles.is_empty() {
+                p = p.with_cells(vtk::CellKind::Tri3, &c.triangles);
+            }
+            if !c.vertices.is_empty() {
+                p = p.with_cells(vtk::CellKind::Vertex, &c.vertices);
+            }
+            let p = p
+                .with_point_data("node_id", vtk::FieldData::Int(&c.node_id))
+                .with_point_data("area", vtk::FieldData::Scalar(&pair.slave_area))
+                .with_point_data("beta", vtk::FieldData::Scalar(&c.beta))
+                .with_point_data("rn", vtk::FieldData::Scalar(&c.rn))
+                .with_point_data("rn_dry", vtk::FieldData::Scalar(&c.rn_dry))
+                .with_point_data("rn_adh", vtk::FieldData::Scalar(&c.rn_adh))
+                .with_point_data("rt", vtk::FieldData::Vector(&c.rt))
+                .with_point_data("rt_adh", vtk::FieldData::Vector(&c.rt_adh))
+                .with_point_data("contact_force", vtk::FieldData::Vector(&c.force))
+                .with_point_data("pn", vtk::FieldData::Scalar(&c.pn))
+                .with_point_data("pn_adh", vtk::FieldData::Scalar(&c.pn_adh))
+                .with_point_data("tt", vtk::FieldData::Vector(&c.tt))
+                .with_point_data("tt_adh", vtk::FieldData::Vector(&c.tt_adh))
+                .with_point_data("traction", vtk::FieldData::Vector(&c.traction))
+                .with_point_data("gap", vtk::FieldData::Scalar(&c.gap))
+                .with_point_data("slip", vtk::FieldData::Scalar(&c.slip))
+                .with_point_data("ut", vtk::FieldData::Vector(&c.ut))
+                .with_point_data("state", vtk::FieldData::Int(&c.state))
+                .with_cell_data("pair_id", vtk::FieldData::Int(&c.pair_id))
+                .with_cell_data("body_id", vtk::FieldData::Int(&c.body_id));
+            let file = format!("{stem}_contact{j}.vtu");
+            vtk::write_vtu(&self.dir.join("vtu").join(&file), &[p])?;
+            contacts.push((pair.name.clone(), file));
+        }
+        let mut groups = vec![vtk::VtmGroup {
+            name: "bodies".into(),
+            datasets: bodies,
+        }];
+        if !contacts.is_empty() {
+            groups.push(vtk::VtmGroup {
+                name: "contacts".into(),
+                datasets: contacts,
+            });
+        }
+        let rel = format!("vtu/{stem}.vtm");
+        vtk::write_vtm(&self.dir.join(&rel), &groups)?;
         self.pvd.push(t, &rel)?;
         self.frames += 1;
         Ok(())
     }
 }
 
-/// Point data of one contact surface.
+/// A node, body or pair index as a VTK integer (indices beyond `i32::MAX` are not expected:
+/// the mesh generator caps the number of cells far below).
+fn id_i32(i: usize) -> i32 {
+    i32::try_from(i).unwrap_or(i32::MAX)
+}
+
+/// Traction [Pa]: a nodal force [N] over the node's tributary area [m²] (0 for a node
+/// without area).
+pub fn traction(force: f64, area: f64) -> f64 {
+    if area > 0.0 {
+        force / area
+    } else {
+        0.0
+    }
+}
+
+/// Point and cell data of one contact surface.
 struct ContactFrame {
     points: Vec<[f64; 3]>,
+    quads: Vec<usize>,
+    triangles: Vec<usize>,
     vertices: Vec<usize>,
+    node_id: Vec<i32>,
     beta: Vec<f64>,
     rn: Vec<f64>,
     rn_dry: Vec<f64>,
@@ -262,26 +326,60 @@ struct ContactFrame {
     rt: Vec<[f64; 3]>,
     rt_adh: Vec<[f64; 3]>,
     force: Vec<[f64; 3]>,
+    pn: Vec<f64>,
+    pn_adh: Vec<f64>,
+    tt: Vec<[f64; 3]>,
+    tt_adh: Vec<[f64; 3]>,
+    traction: Vec<[f64; 3]>,
     gap: Vec<f64>,
     slip: Vec<f64>,
     ut: Vec<[f64; 3]>,
     state: Vec<i32>,
+    pair_id: Vec<i32>,
+    body_id: Vec<i32>,
 }
 
 fn contact_frame(
+    index: usize,
     pair: &crate::contact::ContactPair,
     nodes: &[NodeContact],
     view: &StepView,
 ) -> ContactFrame {
     let u = &view.state.u;
     let x = &view.disc.reference;
+    let (mut quads, mut triangles) = (Vec::new(), Vec::new());
+    let mut on_face = vec![false; pair.slave_nodes.len()];
+    for q in &pair.slave_quads {
+        if q[3] == q[2] {
+            triangles.extend_from_slice(&q[..3]);
+        } else {
+            quads.extend_from_slice(q);
+        }
+        for &i in q {
+            on_face[i] = true;
+        }
+    }
+    let vertices: Vec<usize> = (0..on_face.len()).filter(|&i| !on_face[i]).collect();
+    let n_cells = quads.len() / 4 + triangles.len() / 3 + vertices.len();
+    let slave_body = pair.slave_nodes.first().map_or(0, |&n| {
+        view.disc
+            .node_offset
+            .iter()
+            .rposition(|&off| off <= n)
+            .unwrap_or(0)
+    });
+    let area = &pair.slave_area;
+    let per_area = |v: [f64; 3], a: f64| -> [f64; 3] { v.map(|c| traction(c, a)) };
     let mut f = ContactFrame {
         points: pair
             .slave_nodes
             .iter()
             .map(|&n| std::array::from_fn(|k| x[n][k] + u[3 * n + k]))
             .collect(),
-        vertices: (0..pair.slave_nodes.len()).collect(),
+        quads,
+        triangles,
+        vertices,
+        node_id: pair.slave_nodes.iter().map(|&n| id_i32(n)).collect(),
         beta: nodes.iter().map(|c| c.beta).collect(),
         rn: nodes.iter().map(|c| c.r_dry[2] + c.r_adh[2]).collect(),
         rn_dry: nodes.iter().map(|c| c.r_dry[2]).collect(),
@@ -289,6 +387,11 @@ fn contact_frame(
         rt: Vec::new(),
         rt_adh: Vec::new(),
         force: nodes.iter().map(|c| c.force).collect(),
+        pn: Vec::new(),
+        pn_adh: Vec::new(),
+        tt: Vec::new(),
+        tt_adh: Vec::new(),
+        traction: Vec::new(),
         gap: nodes.iter().map(|c| c.gap).collect(),
         slip: nodes
             .iter()
@@ -296,13 +399,22 @@ fn contact_frame(
             .collect(),
         ut: nodes.iter().map(|c| c.ut).collect(),
         state: nodes.iter().map(|c| c.state).collect(),
+        pair_id: vec![id_i32(index); n_cells],
+        body_id: vec![id_i32(slave_body); n_cells],
     };
-    for c in nodes {
+    for (c, &a) in nodes.iter().zip(area) {
         let t = c.tangent_axes;
         let g =
             |v: [f64; 2]| -> [f64; 3] { std::array::from_fn(|k| v[0] * t[0][k] + v[1] * t[1][k]) };
-        f.rt.push(g([c.r_dry[0] + c.r_adh[0], c.r_dry[1] + c.r_adh[1]]));
-        f.rt_adh.push(g([c.r_adh[0], c.r_adh[1]]));
+        let rt = g([c.r_dry[0] + c.r_adh[0], c.r_dry[1] + c.r_adh[1]]);
+        let rt_adh = g([c.r_adh[0], c.r_adh[1]]);
+        f.pn.push(traction(c.r_dry[2] + c.r_adh[2], a));
+        f.pn_adh.push(traction(c.r_adh[2], a));
+        f.tt.push(per_area(rt, a));
+        f.tt_adh.push(per_area(rt_adh, a));
+        f.traction.push(per_area(c.force, a));
+        f.rt.push(rt);
+        f.rt_adh.push(rt_adh);
     }
     f
 }
@@ -473,5 +585,33 @@ impl Observer for HistoryObserver {
             }
         }
         self.writer.append(&row)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_files_are_recognised_by_their_number() {
+        assert_eq!(frame_file_index("00012.vtm"), Some(12));
+        assert_eq!(frame_file_index("00012.vtu"), Some(12));
+        assert_eq!(frame_file_index("00012_body0.vtu"), Some(12));
+        assert_eq!(frame_file_index("123456_contact3.vtu"), Some(123456));
+        for other in [
+            "0012.vtm",
+            "00012.csv",
+            "00012_.vtu",
+            "x0012.vtm",
+            "00012_body0.vtm",
+        ] {
+            assert_eq!(frame_file_index(other), None, "{other}");
+        }
+    }
+
+    #[test]
+    fn traction_is_force_over_area_and_zero_without_area() {
+        assert_eq!(traction(3.0, 0.5), 6.0);
+        assert_eq!(traction(3.0, 0.0), 0.0);
     }
 }
