@@ -194,6 +194,8 @@ struct FileRotation {
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
 struct FileBoundary {
+    #[serde(default)]
+    name: Option<String>,
     body: String,
     set: String,
     #[serde(default)]
@@ -424,6 +426,8 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
     let mut bodies = Vec::new();
     let mut body_index: BTreeMap<String, usize> = BTreeMap::new();
     let mut dirichlet = Vec::new();
+    // Reaction names, one per entry of `dirichlet` ("" for the plane-strain constraints).
+    let mut boundary_names: Vec<String> = Vec::new();
     for (i, b) in raw.bodies.iter().enumerate() {
         let key = format!("body[{i}]");
         if body_index.insert(b.name.clone(), i).is_some() {
@@ -471,6 +475,7 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
             let nodes = (0..bodies[i].mesh.num_nodes())
                 .map(|n| n + offsets[i])
                 .collect();
+            boundary_names.push(String::new());
             dirichlet.push(Dirichlet {
                 nodes,
                 components: [false, false, true],
@@ -550,6 +555,26 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
                 "`{key}` prescribes nothing: give `fix`, `displacement` or `rotation`"
             )));
         }
+        let default_name = format!("{}.{}", bc.body, bc.set);
+        let name = match &bc.name {
+            Some(n) => {
+                if n.is_empty() || n.contains(['\n', '\r', ',', '"']) {
+                    return Err(ctx.err(format!(
+                        "`{key}.name` = {n:?}: give a non-empty name without commas, quotes \
+                         or line breaks (it heads history columns)"
+                    )));
+                }
+                if boundary_names.contains(n) {
+                    return Err(ctx.err(format!(
+                        "`{key}.name`: the boundary name {n:?} is used twice; names must be unique"
+                    )));
+                }
+                n.clone()
+            }
+            None if boundary_names.contains(&default_name) => format!("{default_name}.{i}"),
+            None => default_name,
+        };
+        boundary_names.push(name);
         dirichlet.push(Dirichlet {
             nodes,
             components,
@@ -706,6 +731,7 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
             frame_interval,
             figures,
             maps,
+            boundary_names,
         },
     })
 }

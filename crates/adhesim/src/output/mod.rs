@@ -9,8 +9,9 @@ pub mod plot;
 pub mod vtk;
 
 use crate::assembly::Discretisation;
+use crate::contact::{Master, RigidShape};
 use crate::element::{element_cauchy_stress, von_mises};
-use crate::problem::Problem;
+use crate::problem::{Dirichlet, Problem};
 use crate::time::{NodeContact, State, StepReport};
 use std::io;
 use std::path::{Path, PathBuf};
@@ -28,6 +29,9 @@ pub struct StepView<'a> {
     pub report: &'a StepReport,
     /// Committed contact state per pair and slave node.
     pub contact: &'a [Vec<NodeContact>],
+    /// Nodal reaction forces of the step [N], 3 per node, zero on free degrees of freedom
+    /// (see [`crate::time::Stepper::reactions`]).
+    pub reactions: &'a [f64],
 }
 
 /// Records a run.
@@ -457,6 +461,25 @@ pub fn history_columns(problem: &Problem) -> Vec<String> {
             c.push(format!("{}.{f}", pair.name));
         }
     }
+    for (name, d) in reported_boundaries(problem) {
+        for f in REACTION_FIELDS {
+            c.push(format!("{name}.{f}"));
+        }
+        c.extend(prescribed_columns(d.components, d.rotation.is_some(), name));
+    }
+    for pair in &problem.contacts {
+        if let Master::Rigid { motion, .. } = &pair.master {
+            let owner = format!("{}.master", pair.name);
+            for f in REACTION_FIELDS {
+                c.push(format!("{owner}.{f}"));
+            }
+            c.extend(prescribed_columns(
+                [true; 3],
+                motion.rotation.is_some(),
+                &owner,
+            ));
+        }
+    }
     for tr in &problem.tracks {
         for f in ["ux", "uy", "uz", "vx", "vy", "vz"] {
             c.push(format!("{}.{f}", tr.name));
@@ -473,6 +496,93 @@ pub fn history_columns(problem: &Problem) -> Vec<String> {
         }
     }
     c
+}
+
+/// Resultant force and moment columns of a reaction: `<owner>.Fx` ... `<owner>.Mz`.
+pub const REACTION_FIELDS: [&str; 6] = ["Fx", "Fy", "Fz", "Mx", "My", "Mz"];
+
+/// The boundaries whose reactions are written, with their names.
+fn reported_boundaries(problem: &Problem) -> impl Iterator<Item = (&str, &Dirichlet)> {
+    problem
+        .output
+        .boundary_names
+        .iter()
+        .zip(&problem.dirichlet)
+        .filter(|(name, _)| !name.is_empty())
+        .map(|(name, d)| (name.as_str(), d))
+}
+
+/// Columns of the prescribed motion of a reaction's owner: `.ux`, `.uy`, `.uz` for the
+/// prescribed translation components [m], then `.angle` [rad] and `.torque` (moment about
+/// the rotation axis [N·m]) when it rotates.
+fn prescribed_columns(components: [bool; 3], rotates: bool, owner: &str) -> Vec<String> {
+    let mut c: Vec<String> = ["ux", "uy", "uz"]
+        .iter()
+        .zip(components)
+        .filter(|(_, on)| *on)
+        .map(|(f, _)| format!("{owner}.{f}"))
+        .collect();
+    if rotates {
+        c.push(format!("{owner}.angle"));
+        c.push(format!("{owner}.torque"));
+    }
+    c
+}
+
+/// Mean of a set of points [m] (the origin for none).
+pub fn centroid(points: impl Iterator<Item = [f64; 3]>) -> [f64; 3] {
+    let (mut sum, mut n) = ([0.0; 3], 0usize);
+    for p in points {
+        for k in 0..3 {
+            sum[k] += p[k];
+        }
+        n += 1;
+    }
+    sum.map(|s| s / n.max(1) as f64)
+}
+
+/// Resultant force [N] and moment about `about` [N·m] of point forces given as
+/// (application point [m], force [N]): F = Σ f, M = Σ (x − about) × f.
+pub fn resultant_and_moment(
+    forces: impl Iterator<Item = ([f64; 3], [f64; 3])>,
+    about: [f64; 3],
+) -> ([f64; 3], [f64; 3]) {
+    let (mut force, mut moment) = ([0.0; 3], [0.0; 3]);
+    for (x, f) in forces {
+        let r: [f64; 3] = std::array::from_fn(|k| x[k] - about[k]);
+        let m = [
+            r[1] * f[2] - r[2] * f[1],
+            r[2] * f[0] - r[0] * f[2],
+            r[0] * f[1] - r[1] * f[0],
+        ];
+        for k in 0..3 {
+            force[k] += f[k];
+            moment[k] += m[k];
+        }
+    }
+    (force, moment)
+}
+
+/// The point of a rigid master about which its moment is taken, in its reference position:
+/// the plane's or cylinder's `point`, the sphere's `center`.
+pub fn shape_reference_point(shape: &RigidShape) -> [f64; 3] {
+    match shape {
+        RigidShape::Plane { point, .. } | RigidShape::Cylinder { point, .. } => *point,
+        RigidShape::Sphere { center, .. } => *center,
+    }
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn unit(a: [f64; 3]) -> [f64; 3] {
+    let n = dot(a, a).sqrt();
+    if n > 0.0 {
+        a.map(|c| c / n)
+    } else {
+        a
+    }
 }
 
 /// Contact fields of one slave node, as written for tracked nodes in the history and in the
@@ -576,6 +686,52 @@ impl Observer for HistoryObserver {
             row.extend_from_slice(&total);
             row.extend_from_slice(&[fn_, fn_adh, ft, ft_adh, bonded]);
         }
+        let x = &view.disc.reference;
+        let u = &view.state.u;
+        let t = view.state.t;
+        let current = |n: usize| -> [f64; 3] { std::array::from_fn(|k| x[n][k] + u[3 * n + k]) };
+        for (_, d) in reported_boundaries(view.problem) {
+            let about = centroid(d.nodes.iter().map(|&n| x[n]));
+            let (force, moment) = resultant_and_moment(
+                d.nodes.iter().map(|&n| {
+                    let r = &view.reactions[3 * n..3 * n + 3];
+                    (current(n), [r[0], r[1], r[2]])
+                }),
+                about,
+            );
+            row.extend_from_slice(&force);
+            row.extend_from_slice(&moment);
+            for k in 0..3 {
+                if d.components[k] {
+                    row.push(d.translation[k].at(t));
+                }
+            }
+            if let Some(r) = &d.rotation {
+                row.push(r.angle.at(t));
+                row.push(dot(moment, unit(r.axis)));
+            }
+        }
+        for (pair, nodes) in view.problem.contacts.iter().zip(view.contact) {
+            if let Master::Rigid { shape, motion } = &pair.master {
+                let about = motion.apply(shape_reference_point(shape), t);
+                let (force, moment) = resultant_and_moment(
+                    pair.slave_nodes
+                        .iter()
+                        .zip(nodes)
+                        .map(|(&n, c)| (current(n), c.force.map(|f| -f))),
+                    about,
+                );
+                row.extend_from_slice(&force);
+                row.extend_from_slice(&moment);
+                for k in 0..3 {
+                    row.push(motion.translation[k].at(t));
+                }
+                if let Some(r) = &motion.rotation {
+                    row.push(r.angle.at(t));
+                    row.push(dot(moment, unit(r.axis)));
+                }
+            }
+        }
         for tr in &view.problem.tracks {
             let n = tr.node;
             row.extend_from_slice(&view.state.u[3 * n..3 * n + 3]);
@@ -607,6 +763,29 @@ mod tests {
         ] {
             assert_eq!(frame_file_index(other), None, "{other}");
         }
+    }
+
+    /// A couple (equal and opposite forces 2 m apart) has no resultant and a moment of
+    /// force × arm whatever the point; a single force has r × f about another point.
+    #[test]
+    fn resultant_and_moment_of_a_couple_and_of_a_single_force() {
+        let couple = [
+            ([1.0, 0.0, 0.0], [0.0, 3.0, 0.0]),
+            ([-1.0, 0.0, 0.0], [0.0, -3.0, 0.0]),
+        ];
+        for about in [[0.0; 3], [5.0, -2.0, 7.0]] {
+            let (f, m) = resultant_and_moment(couple.into_iter(), about);
+            assert_eq!(f, [0.0; 3]);
+            assert_eq!(m, [0.0, 0.0, 6.0]);
+        }
+        let (f, m) =
+            resultant_and_moment([([0.0, 2.0, 0.0], [4.0, 0.0, 0.0])].into_iter(), [0.0; 3]);
+        assert_eq!(f, [4.0, 0.0, 0.0]);
+        assert_eq!(m, [0.0, 0.0, -8.0]);
+        assert_eq!(
+            centroid([[0.0, 0.0, 0.0], [2.0, 4.0, 6.0]].into_iter()),
+            [1.0, 2.0, 3.0]
+        );
     }
 
     #[test]
