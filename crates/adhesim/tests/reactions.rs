@@ -155,15 +155,9 @@ fn twist_reaction_moment_balances_the_contact_moment() {
     problem.time.t_end = 6e-3;
     let block = &problem.bodies[0].mesh;
     let top: Vec<usize> = block.node_sets["top"].clone();
-    let centre = {
-        let mut c = [0.0; 3];
-        for &n in &top {
-            for k in 0..3 {
-                c[k] += block.nodes[n][k] / top.len() as f64;
-            }
-        }
-        c
-    };
+    let centre: [f64; 3] = std::array::from_fn(|k| {
+        top.iter().map(|&n| block.nodes[n][k]).sum::<f64>() / top.len() as f64
+    });
     let mut s = Stepper::new(Arc::new(problem)).unwrap();
     while !s.finished() {
         s.step().unwrap();
