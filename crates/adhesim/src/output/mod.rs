@@ -587,24 +587,34 @@ fn unit(a: [f64; 3]) -> [f64; 3] {
 
 /// Contact fields of one slave node, as written for tracked nodes in the history and in the
 /// contact maps; [`contact_node_values`] gives them in this order.
-pub const CONTACT_NODE_FIELDS: [&str; 9] = [
-    "beta", "rn", "rn_dry", "rn_adh", "rt", "rt_adh", "gap", "slip", "state",
+pub const CONTACT_NODE_FIELDS: [&str; 13] = [
+    "beta", "rn", "rn_dry", "rn_adh", "rt", "rt_adh", "gap", "slip", "state", "pn", "pn_adh", "tt",
+    "tt_adh",
 ];
 
-/// The [`CONTACT_NODE_FIELDS`] of one slave node: β, total, dry and adhesive normal force
-/// [N], norms of the total and adhesive tangential force [N], gap [m], slip of the step [m]
-/// and state code.
-pub fn contact_node_values(c: &NodeContact) -> [f64; 9] {
+/// The [`CONTACT_NODE_FIELDS`] of one slave node of tributary area `area` [m²]: β, total,
+/// dry and adhesive normal force [N], norms of the total and adhesive tangential force [N],
+/// gap [m], slip of the step [m], state code, then the same forces as tractions [Pa]:
+/// contact pressure, adhesive normal traction, norms of the total and adhesive tangential
+/// tractions.
+pub fn contact_node_values(c: &NodeContact, area: f64) -> [f64; 13] {
+    let rn = c.r_dry[2] + c.r_adh[2];
+    let rt = (c.r_dry[0] + c.r_adh[0]).hypot(c.r_dry[1] + c.r_adh[1]);
+    let rt_adh = c.r_adh[0].hypot(c.r_adh[1]);
     [
         c.beta,
-        c.r_dry[2] + c.r_adh[2],
+        rn,
         c.r_dry[2],
         c.r_adh[2],
-        (c.r_dry[0] + c.r_adh[0]).hypot(c.r_dry[1] + c.r_adh[1]),
-        c.r_adh[0].hypot(c.r_adh[1]),
+        rt,
+        rt_adh,
         c.gap,
         c.slip[0].hypot(c.slip[1]),
         c.state as f64,
+        traction(rn, area),
+        traction(c.r_adh[2], area),
+        traction(rt, area),
+        traction(rt_adh, area),
     ]
 }
 
@@ -737,7 +747,8 @@ impl Observer for HistoryObserver {
             row.extend_from_slice(&view.state.u[3 * n..3 * n + 3]);
             row.extend_from_slice(&view.state.v[3 * n..3 * n + 3]);
             for (p, i) in track_contacts(view.problem, n) {
-                row.extend_from_slice(&contact_node_values(&view.contact[p][i]));
+                let area = view.problem.contacts[p].slave_area[i];
+                row.extend_from_slice(&contact_node_values(&view.contact[p][i], area));
             }
         }
         self.writer.append(&row)
