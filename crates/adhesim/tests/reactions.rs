@@ -194,6 +194,30 @@ fn twist_reaction_moment_balances_the_contact_moment() {
     eprintln!(
         "top: F {f_top:?} N, M {m_top:?} N·m; contact: F {f_contact:?} N, M {m_contact:?} N·m"
     );
+    // Pair totals: on the plane y = 0 the tangential resultant is the x, z part of the
+    // resultant contact force, and tiny next to the sum of the nodal tangential force norms
+    // (the nodal forces turn round the centre and cancel).
+    let totals = adhesim::output::pair_totals(&s.contact[0]);
+    let get = |name: &str| {
+        let i = adhesim::output::PAIR_TOTAL_FIELDS
+            .iter()
+            .position(|f| *f == name);
+        totals[i.unwrap()]
+    };
+    let norm_sum = get("ft_norm_sum");
+    assert!(norm_sum > 1e6, "{norm_sum}");
+    for (t, f) in [
+        ("ft_x", f_contact[0]),
+        ("ft_y", 0.0),
+        ("ft_z", f_contact[2]),
+    ] {
+        assert!(
+            (get(t) - f).abs() < 1e-12 * norm_sum,
+            "{t} = {} vs {f}",
+            get(t)
+        );
+    }
+    assert!(get("ft_x").hypot(get("ft_z")) < 1e-6 * norm_sum);
     // The twist loads the interface: a torque about the vertical axis.
     assert!(m_contact[1].abs() > 1e3, "{m_contact:?}");
     // Balance up to the inertia of the block (dynamic run; mass 0.3 g against forces of

@@ -28,7 +28,8 @@ pub fn field_label(field: &str) -> Option<&'static str> {
         "fz" => "total contact force F_z [N]",
         "fn" => "total normal contact force [N]",
         "fn_adh" => "total normal adhesive force [N]",
-        "ft_adh" => "total tangential adhesive force [N]",
+        "ft_norm_sum" => "sum of the nodal tangential force norms Σ‖r_t‖ [N]",
+        "ft_adh_norm_sum" => "sum of the nodal adhesive tangential force norms Σ‖r̃_t‖ [N]",
         "bonded" => "bonded contact nodes [-]",
         _ => return None,
     })

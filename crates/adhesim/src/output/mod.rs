@@ -457,7 +457,7 @@ pub fn history_columns(problem: &Problem) -> Vec<String> {
         c.push(f.into());
     }
     for pair in &problem.contacts {
-        for f in ["fx", "fy", "fz", "fn", "fn_adh", "ft", "ft_adh", "bonded"] {
+        for f in PAIR_TOTAL_FIELDS {
             c.push(format!("{}.{f}", pair.name));
         }
     }
@@ -496,6 +496,56 @@ pub fn history_columns(problem: &Problem) -> Vec<String> {
         }
     }
     c
+}
+
+/// Per-pair columns of the history, `<pair>.<field>`, in the order of [`pair_totals`].
+pub const PAIR_TOTAL_FIELDS: [&str; 14] = [
+    "fx",
+    "fy",
+    "fz",
+    "fn",
+    "fn_adh",
+    "ft_x",
+    "ft_y",
+    "ft_z",
+    "ft_adh_x",
+    "ft_adh_y",
+    "ft_adh_z",
+    "ft_norm_sum",
+    "ft_adh_norm_sum",
+    "bonded",
+];
+
+/// Totals of a pair's contact forces on its slave nodes, in the order of
+/// [`PAIR_TOTAL_FIELDS`]: the resultant contact force (global components) [N]; the sums of
+/// the nodal normal forces and of their adhesive parts [N] (signed, > 0 compression); the
+/// resultant tangential force and the resultant adhesive tangential force (global
+/// components) [N]; the sums of the norms of the nodal tangential forces and of their
+/// adhesive parts [N] (a measure of how much tangential force the interface carries, not a
+/// force: opposite nodal forces add up here and cancel in the resultant); the number of
+/// nodes with β > 0.
+pub fn pair_totals(nodes: &[NodeContact]) -> [f64; 14] {
+    let mut out = [0.0; 14];
+    for c in nodes {
+        let t = c.tangent_axes;
+        let global =
+            |a: f64, b: f64| -> [f64; 3] { std::array::from_fn(|k| a * t[0][k] + b * t[1][k]) };
+        let rt = global(c.r_dry[0] + c.r_adh[0], c.r_dry[1] + c.r_adh[1]);
+        let rt_adh = global(c.r_adh[0], c.r_adh[1]);
+        for k in 0..3 {
+            out[k] += c.force[k];
+            out[5 + k] += rt[k];
+            out[8 + k] += rt_adh[k];
+        }
+        out[3] += c.r_dry[2] + c.r_adh[2];
+        out[4] += c.r_adh[2];
+        out[11] += (c.r_dry[0] + c.r_adh[0]).hypot(c.r_dry[1] + c.r_adh[1]);
+        out[12] += c.r_adh[0].hypot(c.r_adh[1]);
+        if c.beta > 0.0 {
+            out[13] += 1.0;
+        }
+    }
+    out
 }
 
 /// Resultant force and moment columns of a reaction: `<owner>.Fx` ... `<owner>.Mz`.
@@ -679,22 +729,7 @@ impl Observer for HistoryObserver {
         let tm = &r.timings;
         row.extend_from_slice(&[tm.assembly, tm.factorisation, tm.delassus, tm.contact_solve]);
         for nodes in view.contact {
-            let mut total = [0.0; 3];
-            let (mut fn_, mut fn_adh, mut ft, mut ft_adh, mut bonded) = (0.0, 0.0, 0.0, 0.0, 0.0);
-            for c in nodes {
-                for k in 0..3 {
-                    total[k] += c.force[k];
-                }
-                fn_ += c.r_dry[2] + c.r_adh[2];
-                fn_adh += c.r_adh[2];
-                ft += (c.r_dry[0] + c.r_adh[0]).hypot(c.r_dry[1] + c.r_adh[1]);
-                ft_adh += c.r_adh[0].hypot(c.r_adh[1]);
-                if c.beta > 0.0 {
-                    bonded += 1.0;
-                }
-            }
-            row.extend_from_slice(&total);
-            row.extend_from_slice(&[fn_, fn_adh, ft, ft_adh, bonded]);
+            row.extend_from_slice(&pair_totals(nodes));
         }
         let x = &view.disc.reference;
         let u = &view.state.u;
@@ -797,6 +832,37 @@ mod tests {
             centroid([[0.0, 0.0, 0.0], [2.0, 4.0, 6.0]].into_iter()),
             [1.0, 2.0, 3.0]
         );
+    }
+
+    /// Two nodes with opposite tangential forces of 3 N (one of them adhesive) and normal
+    /// forces 2 N and 5 N: the resultant tangential force is zero, the sum of norms 6 N.
+    #[test]
+    fn pair_totals_separate_the_resultant_from_the_sum_of_norms() {
+        let axes = [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0]];
+        let a = NodeContact {
+            r_dry: [3.0, 0.0, 2.0],
+            force: [0.0, 2.0, 3.0],
+            tangent_axes: axes,
+            beta: 0.5,
+            ..Default::default()
+        };
+        let b = NodeContact {
+            r_adh: [-3.0, 0.0, 5.0],
+            force: [0.0, 5.0, -3.0],
+            tangent_axes: axes,
+            ..Default::default()
+        };
+        let t = pair_totals(&[a, b]);
+        let get = |name: &str| t[PAIR_TOTAL_FIELDS.iter().position(|f| *f == name).unwrap()];
+        assert_eq!([get("fx"), get("fy"), get("fz")], [0.0, 7.0, 0.0]);
+        assert_eq!([get("ft_x"), get("ft_y"), get("ft_z")], [0.0; 3]);
+        assert_eq!(
+            [get("ft_adh_x"), get("ft_adh_y"), get("ft_adh_z")],
+            [0.0, 0.0, -3.0]
+        );
+        assert_eq!(get("ft_norm_sum"), 6.0);
+        assert_eq!(get("ft_adh_norm_sum"), 3.0);
+        assert_eq!((get("fn"), get("fn_adh"), get("bonded")), (7.0, 5.0, 1.0));
     }
 
     #[test]
