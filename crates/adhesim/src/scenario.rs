@@ -390,9 +390,19 @@ pub fn parse_with(
             )
             .collect();
         FileScenario::deserialize(toml::Value::Table(doc)).map_err(|e| {
+            let message = e.to_string();
+            let why = if message.contains("floating point") && !prepared.fractional.is_empty() {
+                format!(
+                    "; expressions that gave fractional numbers: {} (keys that count, such \
+                     as `divisions`, need whole numbers)",
+                    prepared.fractional.join(", ")
+                )
+            } else {
+                String::new()
+            };
             ctx.err(format!(
-                "{}{}\n{hint}",
-                e.to_string().trim_end(),
+                "{}{}{why}\n{hint}",
+                message.trim_end(),
                 if applied.is_empty() {
                     " (after evaluating parameters and expressions)".to_string()
                 } else {
