@@ -1,4 +1,5 @@
-//! VTK XML output: unstructured grids (`.vtu`) and ParaView time collections (`.pvd`).
+//! VTK XML output: unstructured grids (`.vtu`), multiblock files grouping them (`.vtm`,
+//! [`write_vtm`]) and ParaView time collections (`.pvd`).
 //!
 //! # File format
 //!
@@ -20,7 +21,9 @@
 //!
 //! # Several pieces
 //!
-//! A file may hold several pieces (for example each body and the contact surface). Point and
+//! A file may hold several pieces. The run's frames do not use this (they write one grid per
+//! body and per contact surface, grouped by a `.vtm`, since meshio keeps only the cells of
+//! the last piece and every piece must carry every array). Point and
 //! cell indices are local to each piece. Readers (ParaView, meshio) expect every piece to
 //! carry the same arrays, so the file gets the union of the field names of all pieces, in
 //! order of first appearance; a piece lacking a field is padded with `NaN` (real fields) or
