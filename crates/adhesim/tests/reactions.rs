@@ -234,3 +234,26 @@ fn twist_reaction_moment_balances_the_contact_moment() {
         );
     }
 }
+
+/// Boundary names head history columns: a name given twice is an error naming the key, and
+/// two unnamed boundaries on one set get distinct default names.
+#[test]
+fn boundary_names_are_unique() {
+    let two_named = block_scenario().replacen(
+        "[[boundary]]\nbody = \"lower\"\nset = \"left\"",
+        "[[boundary]]\nname = \"base\"\nbody = \"lower\"\nset = \"left\"",
+        1,
+    );
+    let err = adhesim::scenario::parse(&two_named, Path::new("stack.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("`boundary[2].name`") && err.contains("\"base\""),
+        "{err}"
+    );
+    let same_set = block_scenario().replacen("set = \"back\"", "set = \"left\"", 1);
+    let p = adhesim::scenario::parse(&same_set, Path::new("stack.toml")).unwrap();
+    let names = &p.output.boundary_names;
+    assert!(names.contains(&"lower.left".to_string()), "{names:?}");
+    assert!(names.contains(&"lower.left.3".to_string()), "{names:?}");
+}
