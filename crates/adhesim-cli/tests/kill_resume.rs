@@ -104,14 +104,32 @@ fn check_outputs_readable(out: &Path) -> usize {
         .collect();
     assert!(!files.is_empty());
     for f in files {
-        let vtu = std::fs::read_to_string(out.join(f))
+        let vtm = std::fs::read_to_string(out.join(f))
             .unwrap_or_else(|e| panic!("frame {f} listed in the PVD: {e}"));
-        let doc = roxmltree::Document::parse(&vtu)
+        let doc = roxmltree::Document::parse(&vtm)
             .unwrap_or_else(|e| panic!("frame {f} is not well-formed XML: {e}"));
         assert_eq!(
             doc.root_element().attribute("type"),
-            Some("UnstructuredGrid")
+            Some("vtkMultiBlockDataSet")
         );
+        let dir = out.join(f);
+        let dir = dir.parent().unwrap();
+        let grids: Vec<&str> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("DataSet"))
+            .map(|n| n.attribute("file").unwrap())
+            .collect();
+        assert!(!grids.is_empty(), "frame {f} lists no data set");
+        for g in grids {
+            let vtu = std::fs::read_to_string(dir.join(g))
+                .unwrap_or_else(|e| panic!("data set {g} listed in {f}: {e}"));
+            let doc = roxmltree::Document::parse(&vtu)
+                .unwrap_or_else(|e| panic!("data set {g} is not well-formed XML: {e}"));
+            assert_eq!(
+                doc.root_element().attribute("type"),
+                Some("UnstructuredGrid")
+            );
+        }
     }
     rows.len()
 }

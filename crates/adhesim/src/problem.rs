@@ -199,6 +199,9 @@ pub struct OutputSettings {
     pub figures: bool,
     /// Maps of contact fields over a pair's slave surface at given times.
     pub maps: Vec<MapRequest>,
+    /// Name under which the reaction of each entry of [`Problem::dirichlet`] is written to
+    /// the history (same order); an empty name, or an entry beyond the list, is not written.
+    pub boundary_names: Vec<String>,
 }
 
 /// Maps of contact fields over the slave surface of a contact pair, drawn at the first

@@ -265,6 +265,7 @@ pub fn run_with(
                 state: &stepper.state,
                 report: &initial,
                 contact: &stepper.contact,
+                reactions: stepper.reactions(),
             };
             frames.observe(&view).map_err(io_err)?;
             history.observe(&view).map_err(io_err)?;
@@ -325,6 +326,7 @@ pub fn run_with(
                         state: &stepper.state,
                         report: &report,
                         contact: &stepper.contact,
+                        reactions: stepper.reactions(),
                     };
                     frames.observe(&view).map_err(io_err)?;
                     history.observe(&view).map_err(io_err)?;

@@ -238,6 +238,8 @@ struct FileRotation {
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
 struct FileBoundary {
+    #[serde(default)]
+    name: Option<String>,
     body: String,
     set: String,
     #[serde(default)]
@@ -432,9 +434,19 @@ pub fn parse_with(
             )
             .collect();
         FileScenario::deserialize(toml::Value::Table(doc)).map_err(|e| {
+            let message = e.to_string();
+            let why = if message.contains("floating point") && !prepared.fractional.is_empty() {
+                format!(
+                    "; expressions that gave fractional numbers: {} (keys that count, such \
+                     as `divisions`, need whole numbers)",
+                    prepared.fractional.join(", ")
+                )
+            } else {
+                String::new()
+            };
             ctx.err(format!(
-                "{}{}\n{hint}",
-                e.to_string().trim_end(),
+                "{}{}{why}\n{hint}",
+                message.trim_end(),
                 if applied.is_empty() {
                     " (after evaluating parameters and expressions)".to_string()
                 } else {
@@ -468,6 +480,8 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
     let mut bodies = Vec::new();
     let mut body_index: BTreeMap<String, usize> = BTreeMap::new();
     let mut dirichlet = Vec::new();
+    // Reaction names, one per entry of `dirichlet` ("" for the plane-strain constraints).
+    let mut boundary_names: Vec<String> = Vec::new();
     for (i, b) in raw.bodies.iter().enumerate() {
         let key = format!("body[{i}]");
         if body_index.insert(b.name.clone(), i).is_some() {
@@ -532,6 +546,7 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
             let nodes = (0..bodies[i].mesh.num_nodes())
                 .map(|n| n + offsets[i])
                 .collect();
+            boundary_names.push(String::new());
             dirichlet.push(Dirichlet {
                 nodes,
                 components: [false, false, true],
@@ -611,6 +626,26 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
                 "`{key}` prescribes nothing: give `fix`, `displacement` or `rotation`"
             )));
         }
+        let default_name = format!("{}.{}", bc.body, bc.set);
+        let name = match &bc.name {
+            Some(n) => {
+                if n.is_empty() || n.contains(['\n', '\r', ',', '"']) {
+                    return Err(ctx.err(format!(
+                        "`{key}.name` = {n:?}: give a non-empty name without commas, quotes \
+                         or line breaks (it heads history columns)"
+                    )));
+                }
+                if boundary_names.contains(n) {
+                    return Err(ctx.err(format!(
+                        "`{key}.name`: the boundary name {n:?} is used twice; names must be unique"
+                    )));
+                }
+                n.clone()
+            }
+            None if boundary_names.contains(&default_name) => format!("{default_name}.{i}"),
+            None => default_name,
+        };
+        boundary_names.push(name);
         dirichlet.push(Dirichlet {
             nodes,
             components,
@@ -767,6 +802,7 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
             frame_interval,
             figures,
             maps,
+            boundary_names,
         },
     })
 }

@@ -9,6 +9,9 @@
 //! - `sweep.json`: the plan (scenario, variant, fixed overrides, axes, cases), written
 //!   before any case runs, from which a sweep is resumed, submitted to Slurm
 //!   ([`crate::slurm`]) or collected ([`collect`]) from whatever cases have run.
+//! - `figures/peak_<column>_vs_<key>.png`: the peak of a tracked quantity (its value of
+//!   largest magnitude over the run: peak β, peak pull-off force) against each numeric swept
+//!   key, one curve per combination of the other keys' values.
 
 use crate::output::csv::read_history;
 use crate::output::plot::{draw_line_plot, LinePlot, PlotError, Series};
@@ -633,8 +636,10 @@ fn assemble(
         .iter()
         .map(|c| read_history(out_dir.join(&c.dir_name).join("history.csv")).ok())
         .collect();
-    write_summary(out_dir, &plan.parsed_axes(), cases, &results, &histories)?;
-    let figures = draw_comparison(out_dir, cases, &histories)?;
+    let axes = plan.parsed_axes();
+    write_summary(out_dir, &axes, cases, &results, &histories)?;
+    let mut figures = draw_comparison(out_dir, cases, &histories)?;
+    figures.extend(draw_peak_figures(out_dir, &axes, cases, &histories)?);
     Ok(Collected {
         plan: plan.clone(),
         results,
@@ -801,9 +806,164 @@ pub fn draw_comparison(
     Ok(written)
 }
 
+/// Unit of a swept key, from its last part, for legends and axes ("" when unknown).
+fn key_unit(key: &str) -> &'static str {
+    match key.rsplit('.').next().unwrap_or(key) {
+        "friction" | "mu" | "poisson" | "theta" | "xi" => "-",
+        "w" => "J/m²",
+        "cn" | "ct" => "N/m³",
+        "b" => "N·s/m",
+        "g" | "young" => "Pa",
+        "density" => "kg/m³",
+        "dt" | "t_end" => "s",
+        "omega" | "angular_velocity" => "rad/s",
+        _ => "",
+    }
+}
+
+fn with_unit(text: &str, key: &str) -> String {
+    match key_unit(key) {
+        "" => text.to_string(),
+        u => format!("{text} {u}"),
+    }
+}
+
+/// The value of largest magnitude of a history column (its sign kept), over finite values.
+fn peak(rows: &[Vec<f64>], k: usize) -> Option<f64> {
+    rows.iter().map(|r| r[k]).filter(|x| x.is_finite()).fold(
+        None,
+        |best: Option<f64>, x| match best {
+            Some(b) if b.abs() >= x.abs() => Some(b),
+            _ => Some(x),
+        },
+    )
+}
+
+/// Curves of the peak of `column` against the numeric values of axis `along`, one per
+/// combination of the other axes' values (cases with a missing history or a non-numeric
+/// value left out). Labels hold the other keys' values with their units.
+fn peak_series(
+    axes: &[Axis],
+    cases: &[Case],
+    histories: &[Option<History>],
+    column: &str,
+    along: usize,
+) -> Vec<Series> {
+    let mut series: Vec<Series> = Vec::new();
+    for (case, h) in cases.iter().zip(histories) {
+        let Some((cols, rows)) = h else { continue };
+        let Some(k) = cols.iter().position(|c| c == column) else {
+            continue;
+        };
+        let (Ok(x), Some(y)) = (case.texts[along].parse::<f64>(), peak(rows, k)) else {
+            continue;
+        };
+        let label: Vec<String> = axes
+            .iter()
+            .zip(&case.texts)
+            .enumerate()
+            .filter(|(j, _)| *j != along)
+            .map(|(_, (a, t))| with_unit(&format!("{}={t}", a.short()), &a.key))
+            .collect();
+        let label = if label.is_empty() {
+            column.to_string()
+        } else {
+            label.join(", ")
+        };
+        match series.iter_mut().find(|s| s.label == label) {
+            Some(s) => {
+                s.x.push(x);
+                s.y.push(y);
+            }
+            None => series.push(Series {
+                label,
+                x: vec![x],
+                y: vec![y],
+            }),
+        }
+    }
+    for s in &mut series {
+        let mut pts: Vec<(f64, f64)> = s.x.iter().copied().zip(s.y.iter().copied()).collect();
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        (s.x, s.y) = pts.into_iter().unzip();
+    }
+    series
+}
+
+/// The peak figures (see the module documentation).
+fn draw_peak_figures(
+    out_dir: &Path,
+    axes: &[Axis],
+    cases: &[Case],
+    histories: &[Option<History>],
+) -> Result<Vec<PathBuf>, SweepError> {
+    let tracked = columns_where(histories, |c| {
+        c.rsplit_once('.')
+            .is_some_and(|(_, f)| crate::output::figures::field_label(f).is_some())
+    });
+    let mut written = Vec::new();
+    for (along, axis) in axes.iter().enumerate() {
+        let numeric = axis.texts.iter().all(|t| t.parse::<f64>().is_ok());
+        if !numeric || axis.texts.len() < 2 {
+            continue;
+        }
+        for column in &tracked {
+            let series = peak_series(axes, cases, histories, column, along);
+            if series.is_empty() {
+                continue;
+            }
+            let field = column.rsplit_once('.').map(|(_, f)| f).unwrap_or(column);
+            let y_label = crate::output::figures::field_label(field).unwrap_or(field);
+            let plot = LinePlot {
+                title: format!("peak of {column} against {}", axis.short()),
+                x_label: match key_unit(&axis.key) {
+                    "" => axis.key.clone(),
+                    u => format!("{} [{u}]", axis.key),
+                },
+                y_label: format!("peak {y_label}"),
+                series,
+            };
+            let file = out_dir
+                .join("figures")
+                .join(format!("peak_{column}_vs_{}.png", axis.short()));
+            draw_line_plot(&file, &plot)?;
+            written.push(file);
+        }
+    }
+    Ok(written)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Two axes (μ × w), a history per case whose column `p.fy` has a known peak: the curves
+    /// against μ are one per w, sorted by μ, with the peak of largest magnitude (sign kept).
+    #[test]
+    fn peak_series_group_by_the_other_keys_with_units() {
+        let axes = vec![
+            Axis::parse("parameters.mu=0.4,0.2").unwrap(),
+            Axis::parse("parameters.w=100,0").unwrap(),
+        ];
+        let cases = cases(&axes);
+        let histories: Vec<Option<History>> = cases
+            .iter()
+            .map(|c| {
+                let mu: f64 = c.texts[0].parse().unwrap();
+                let w: f64 = c.texts[1].parse().unwrap();
+                // Pull-off: the force dips to −(w + 10 μ) before coming back.
+                let rows = vec![vec![0.0, 1.0], vec![1.0, -(w + 10.0 * mu)], vec![2.0, 0.5]];
+                Some((vec!["t".to_string(), "p.fy".to_string()], rows))
+            })
+            .collect();
+        let s = peak_series(&axes, &cases, &histories, "p.fy", 0);
+        assert_eq!(s.len(), 2);
+        assert_eq!(s[0].label, "w=100 J/m²");
+        assert_eq!(s[0].x, [0.2, 0.4]);
+        assert_eq!(s[0].y, [-102.0, -104.0]);
+        assert_eq!(s[1].label, "w=0 J/m²");
+        assert_eq!(s[1].y, [-2.0, -4.0]);
+    }
 
     #[test]
     fn cases_are_the_cartesian_product_first_axis_slowest() {

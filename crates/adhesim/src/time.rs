@@ -193,6 +193,8 @@ pub struct Stepper {
     model_size: f64,
     /// The last Delassus operator and what it was built for (see [`delassus_key`]).
     delassus_cache: Option<(Vec<u64>, Delassus)>,
+    /// Nodal reaction forces of the last committed step [N] (see [`Stepper::reactions`]).
+    reactions: Vec<f64>,
 }
 
 struct Attempt {
@@ -210,6 +212,7 @@ struct Attempt {
     contact_residual: f64,
     delassus_builds: usize,
     timings: PhaseTimes,
+    reactions: Vec<f64>,
 }
 
 impl Stepper {
@@ -281,6 +284,7 @@ impl Stepper {
             contact: Vec::new(),
             model_size: 0.0,
             delassus_cache: None,
+            reactions: vec![0.0; n],
         };
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for p in &s.disc.reference {
@@ -403,6 +407,13 @@ impl Stepper {
         Ok(())
     }
 
+    /// Nodal reaction forces [N] of the last committed step, 3 per node: the force the
+    /// prescribed displacements exert on the bodies at each constrained degree of freedom,
+    /// zero on free ones (and everywhere before the first step).
+    pub fn reactions(&self) -> &[f64] {
+        &self.reactions
+    }
+
     /// True when the end time has been reached.
     pub fn finished(&self) -> bool {
         self.state.t >= self.problem.time.t_end * (1.0 - 1e-12)
@@ -434,6 +445,7 @@ impl Stepper {
             match self.attempt(dt) {
                 Ok(a) => {
                     self.commit_contact(&a.points, &a.solutions);
+                    self.reactions = a.reactions;
                     let (contact_sweeps, contact_points, timings, contact_residual) =
                         (a.sweeps, a.points.len(), a.timings, a.contact_residual);
                     self.commit(a.u, a.v, dt);
@@ -852,6 +864,7 @@ impl Stepper {
                     contact_residual,
                     delassus_builds,
                     timings,
+                    reactions,
                 });
             }
             if iter == ts.max_newton {

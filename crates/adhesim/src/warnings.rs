@@ -6,8 +6,12 @@
 //! - the adhesive normal stiffness C_n of a contact pair is so large, compared with the
 //!   stiffness of the slave body at a node, that the contact solve is ill-conditioned
 //!   (see [`CN_STIFFNESS_RATIO`]);
-//! - a rigid sphere or cylinder indents the slave surface over a contact half-width of fewer
-//!   than [`MIN_ELEMENTS_ACROSS_CONTACT`] slave elements.
+//! - the adhesive cohesive zone E*/C_n is shorter than the slave elements
+//!   ([`cohesive_zone_length`]): the peak adhesive traction then falls between nodes and the
+//!   de-bonding front jumps from node to node;
+//! - a rigid sphere or cylinder indents the slave surface over a contact half-width √(R d) of
+//!   fewer than [`MIN_ELEMENTS_ACROSS_CONTACT`] slave elements, measured where the contact
+//!   starts (the local element size, not the mean over the surface).
 
 use crate::contact::{Master, RigidShape};
 use crate::mesh::Mesh;
@@ -26,6 +30,13 @@ pub const CN_STIFFNESS_RATIO: f64 = 1e4;
 
 /// Warn when the estimated contact half-width holds fewer slave elements than this.
 pub const MIN_ELEMENTS_ACROSS_CONTACT: f64 = 3.0;
+
+/// Length of the adhesive cohesive zone E*/C_n [m]: the plane-strain modulus
+/// E* = E/(1 − ν²) [Pa] of the slave body over the adhesive normal stiffness C_n [N/m³].
+/// Over a length much shorter than this the body is stiffer than the adhesive layer.
+pub fn cohesive_zone_length(young: f64, poisson: f64, cn: f64) -> f64 {
+    young / (1.0 - poisson * poisson) / cn
+}
 
 /// The warnings for a validated problem, each stating the number that triggered it and the
 /// threshold. Empty when nothing looks suspicious.
@@ -186,6 +197,16 @@ fn contact_warnings(problem: &Problem, out: &mut Vec<String>) {
                 let g = body.material.shear_modulus();
                 let k = body.material.bulk_modulus();
                 let e = 9.0 * k * g / (3.0 * k + g);
+                let nu = (3.0 * k - 2.0 * g) / (2.0 * (3.0 * k + g));
+                let zone = cohesive_zone_length(e, nu, a.cn);
+                if zone < h {
+                    out.push(format!(
+                        "contact {:?}: the cohesive zone E*/C_n = {zone:.3e} m (E* = E/(1 − ν²) = {:.3e} Pa, C_n = {:.3e} N/m³) is shorter than the mean slave edge {h:.3e} m (warning below one edge): the peak adhesive traction falls between nodes and de-bonding jumps from node to node; refine the slave surface to a few elements per {zone:.3e} m or lower C_n",
+                        pair.name,
+                        e / (1.0 - nu * nu),
+                        a.cn
+                    ));
+                }
                 let link = a.cn * area;
                 let body_stiffness = e * h;
                 let ratio = link / body_stiffness;
@@ -227,11 +248,25 @@ fn contact_warnings(problem: &Problem, out: &mut Vec<String>) {
             if depth.is_nan() || depth <= 0.0 {
                 continue;
             }
-            let half_width = (2.0 * radius * depth).sqrt();
-            let across = half_width / h;
+            let half_width = (radius * depth).sqrt();
+            // The element size where contact starts: around the slave node nearest to the
+            // master, leaving out edges along a cylinder's axis (they do not cut the zone).
+            let nearest = (0..pair.slave_nodes.len()).min_by(|&i, &j| {
+                let d = |i: usize| distance_outside(shape, coord(pair.slave_nodes[i]));
+                d(i).total_cmp(&d(j))
+            });
+            let along = match *shape {
+                RigidShape::Cylinder { axis, .. } => Some(axis),
+                _ => None,
+            };
+            let local = nearest
+                .map(|i| local_slave_edge(pair, i, &coord, along))
+                .filter(|l| *l > 0.0 && l.is_finite())
+                .unwrap_or(h);
+            let across = half_width / local;
             if across < MIN_ELEMENTS_ACROSS_CONTACT {
                 out.push(format!(
-                    "contact {:?}: the contact half-width under the rigid master, about √(2 R d) = {half_width:.3e} m (R = {radius:.3e} m, indentation d = {depth:.3e} m), spans {across:.2} slave elements (mean slave edge {h:.3e} m; warning below {MIN_ELEMENTS_ACROSS_CONTACT:.0}): the mesh is too coarse to resolve the contact zone; refine the slave surface",
+                    "contact {:?}: the contact half-width under the rigid master, about √(R d) = {half_width:.3e} m (R = {radius:.3e} m, indentation d = {depth:.3e} m), spans {across:.2} slave elements (slave edge {local:.3e} m where contact starts; warning below {MIN_ELEMENTS_ACROSS_CONTACT:.0}): the mesh is too coarse to resolve the contact zone; refine the slave surface",
                     pair.name
                 ));
             }
@@ -259,6 +294,54 @@ fn distance_outside(shape: &RigidShape, x: [f64; 3]) -> f64 {
             (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt() - radius
         }
         RigidShape::Plane { .. } => 0.0,
+    }
+}
+
+/// Mean length of the slave face edges that meet at slave node `local` (index into the
+/// pair's slave nodes) [m], leaving out edges within about 25° of `along` when given; NaN when
+/// there is none.
+fn local_slave_edge(
+    pair: &crate::contact::ContactPair,
+    local: usize,
+    coord: &dyn Fn(usize) -> [f64; 3],
+    along: Option<[f64; 3]>,
+) -> f64 {
+    let (mut sum, mut count) = (0.0, 0usize);
+    for q in &pair.slave_quads {
+        let mut nodes = q.to_vec();
+        nodes.dedup();
+        if nodes.len() > 1 && nodes[0] == nodes[nodes.len() - 1] {
+            nodes.pop();
+        }
+        for i in 0..nodes.len() {
+            let (a, b) = (nodes[i], nodes[(i + 1) % nodes.len()]);
+            if a != local && b != local {
+                continue;
+            }
+            let (Some(&ga), Some(&gb)) = (pair.slave_nodes.get(a), pair.slave_nodes.get(b)) else {
+                continue;
+            };
+            let (pa, pb) = (coord(ga), coord(gb));
+            let len = dist(pa, pb);
+            if let Some(ax) = along {
+                let n = dist(ax, [0.0; 3]);
+                let cos =
+                    ((pb[0] - pa[0]) * ax[0] + (pb[1] - pa[1]) * ax[1] + (pb[2] - pa[2]) * ax[2])
+                        / (len * n);
+                if cos.abs() > 0.9 {
+                    continue;
+                }
+            }
+            if len > 0.0 {
+                sum += len;
+                count += 1;
+            }
+        }
+    }
+    if count == 0 {
+        f64::NAN
+    } else {
+        sum / count as f64
     }
 }
 
@@ -398,8 +481,36 @@ adhesion = {{ w = 20.0, cn = {cn:e}, ct = 2e9, b = 0.1 }}
     }
 
     #[test]
+    fn cohesive_zone_shorter_than_the_slave_elements_warns() {
+        // Blatz-Ko G = 16 MPa: ν = 1/4, E = 40 MPa, E* = E/(1 − 1/16) = 42.667 MPa. With
+        // C_n = 2e11 N/m³ the zone is 2.133e-4 m, below the 0.5 mm elements; with the shipped
+        // 2e9 N/m³ it is 21 mm.
+        assert!((cohesive_zone_length(40e6, 0.25, 2e11) - 2.1333333e-4).abs() < 1e-10);
+        let w = physical_warnings(&problem(&indentation(60, 2e11, 1e-3, "quasi-static", 0.02)));
+        assert!(has(&w, "cohesive zone E*/C_n = 2.133e-4 m"), "{w:?}");
+        let w = physical_warnings(&problem(&indentation(60, 2e9, 1e-3, "quasi-static", 0.02)));
+        assert!(!has(&w, "cohesive zone"), "{w:?}");
+    }
+
+    /// The contact half-width is compared with the in-plane element size where contact
+    /// starts. 120 elements over 30 mm: 0.25 mm edges in the plane, 1 mm along the cylinder's
+    /// axis; the surface's mean edge (0.625 mm) against √(2 R d) = 1.7 mm would have given
+    /// 2.8 elements and a false warning, the local edge against √(R d) = 1.2 mm gives 4.9.
+    #[test]
+    fn contact_width_uses_the_local_element_size() {
+        let in_plane = 0.03 / 120.0;
+        let a = (0.015f64 * 1e-4).sqrt();
+        assert!(a / in_plane > 3.0);
+        let w = physical_warnings(&problem(&indentation(120, 2e9, 1e-4, "quasi-static", 0.02)));
+        assert!(!has(&w, "too coarse"), "{w:?}");
+        // 40 elements (0.75 mm edges): 1.6 elements across, a warning that says so.
+        let w = physical_warnings(&problem(&indentation(40, 2e9, 1e-4, "quasi-static", 0.02)));
+        assert!(has(&w, "spans 1.63 slave elements"), "{w:?}");
+    }
+
+    #[test]
     fn coarse_mesh_under_a_rigid_cylinder_warns() {
-        // 6 elements over 30 mm: h ≈ 2.9 mm mean edge, a = √(2·15·0.1) mm ≈ 1.7 mm.
+        // 6 elements over 30 mm: 5 mm in-plane edges, a = √(15·0.1) mm ≈ 1.2 mm.
         let w = physical_warnings(&problem(&indentation(6, 2e9, 1e-4, "quasi-static", 0.02)));
         assert!(has(&w, "too coarse"), "{w:?}");
         assert!(has(&w, "warning below 3"), "{w:?}");

@@ -31,6 +31,10 @@ fn map_label(field: &str) -> &'static str {
         "gap" => "gap x_n [m]",
         "slip" => "slip over the step [m]",
         "state" => "0 none, 1 apart, 2 stick, 3 slide",
+        "pn" => "contact pressure p_n [Pa]",
+        "pn_adh" => "adhesive normal traction [Pa]",
+        "tt" => "tangential traction ‖t_t‖ [Pa]",
+        "tt_adh" => "adhesive tangential traction [Pa]",
         _ => "",
     }
 }
@@ -124,7 +128,7 @@ impl Observer for MapObserver {
                 {
                     let x = view.disc.reference[n];
                     text.push_str(&format!("{i},{:e},{:e},{:e},{:e}", x[0], x[1], x[2], t));
-                    let values = contact_node_values(c);
+                    let values = contact_node_values(c, pair.slave_area[i]);
                     for &k in &cols {
                         text.push_str(&format!(",{:e}", values[k]));
                     }

@@ -9,8 +9,9 @@ pub mod plot;
 pub mod vtk;
 
 use crate::assembly::Discretisation;
+use crate::contact::{Master, RigidShape};
 use crate::element::{element_cauchy_stress, von_mises};
-use crate::problem::Problem;
+use crate::problem::{Dirichlet, Problem};
 use crate::time::{NodeContact, State, StepReport};
 use std::io;
 use std::path::{Path, PathBuf};
@@ -28,6 +29,9 @@ pub struct StepView<'a> {
     pub report: &'a StepReport,
     /// Committed contact state per pair and slave node.
     pub contact: &'a [Vec<NodeContact>],
+    /// Nodal reaction forces of the step [N], 3 per node, zero on free degrees of freedom
+    /// (see [`crate::time::Stepper::reactions`]).
+    pub reactions: &'a [f64],
 }
 
 /// Records a run.
@@ -47,7 +51,9 @@ pub struct FrameWriter {
 }
 
 impl FrameWriter {
-    /// Frames go to `DIR/vtu/<name>_NNNNN.vtu`, the collection to `DIR/<name>.pvd`.
+    /// Frame `NNNNN` is the multiblock file `DIR/vtu/<name>_NNNNN.vtm` over one grid per body,
+    /// `DIR/vtu/<name>_NNNNN_body<i>.vtu`, and one per contact pair,
+    /// `DIR/vtu/<name>_NNNNN_contact<j>.vtu`; the collection over time is `DIR/<name>.pvd`.
     pub fn new(dir: &Path, name: &str, interval: f64) -> io::Result<Self> {
         std::fs::create_dir_all(dir.join("vtu"))?;
         let pvd = vtk::PvdWriter::new(dir.join(format!("{name}.pvd")))?;
@@ -90,11 +96,7 @@ impl FrameWriter {
         for entry in std::fs::read_dir(&vtu)? {
             let file = entry?.file_name();
             let Some(file) = file.to_str() else { continue };
-            let index = file
-                .strip_prefix(&prefix)
-                .and_then(|r| r.strip_suffix(".vtu"))
-                .filter(|r| r.len() >= 5 && r.bytes().all(|b| b.is_ascii_digit()))
-                .and_then(|r| r.parse::<usize>().ok());
+            let index = file.strip_prefix(&prefix).and_then(frame_file_index);
             if index.is_some_and(|i| i >= progress.frames) {
                 std::fs::remove_file(vtu.join(file))?;
             }
@@ -122,6 +124,22 @@ pub struct FrameProgress {
     pub entries: Vec<vtk::PvdEntry>,
 }
 
+/// The frame number of a file name with the `<name>_` prefix removed: `NNNNN.vtm`,
+/// `NNNNN.vtu` (single-file frames of earlier versions) or `NNNNN_<block>.vtu`, with at least
+/// five digits; `None` for any other name.
+fn frame_file_index(rest: &str) -> Option<usize> {
+    let digits = rest.bytes().take_while(u8::is_ascii_digit).count();
+    let (number, tail) = rest.split_at(digits);
+    let known = tail == ".vtm"
+        || tail == ".vtu"
+        || (tail.starts_with('_') && tail.len() > 5 && tail.ends_with(".vtu"));
+    if digits >= 5 && known {
+        number.parse().ok()
+    } else {
+        None
+    }
+}
+
 /// Per-body arrays of one frame.
 struct BodyFrame {
     points: Vec<[f64; 3]>,
@@ -132,6 +150,8 @@ struct BodyFrame {
     cauchy: Vec<[f64; 9]>,
     mises: Vec<f64>,
     jac: Vec<f64>,
+    node_id: Vec<i32>,
+    body_id: Vec<i32>,
 }
 
 fn body_frames(view: &StepView) -> Vec<BodyFrame> {
@@ -160,6 +180,8 @@ fn body_frames(view: &StepView) -> Vec<BodyFrame> {
             cauchy: Vec::new(),
             mises: Vec::new(),
             jac: Vec::new(),
+            node_id: (0..nn).map(|i| id_i32(off + i)).collect(),
+            body_id: vec![id_i32(bi); body.mesh.num_cells()],
         };
         let mat = &*disc.materials[bi];
         let mut push = |s: crate::Mat3, j: f64| {
@@ -204,61 +226,107 @@ impl Observer for FrameWriter {
                 f64::INFINITY
             };
         }
-        let frames = body_frames(view);
-        let pieces: Vec<vtk::Piece> = frames
-            .iter()
-            .map(|f| {
-                let mut p = vtk::Piece::new(&f.points);
-                if !f.hex_conn.is_empty() {
-                    p = p.with_cells(vtk::CellKind::Hex8, &f.hex_conn);
-                }
-                if !f.tet_conn.is_empty() {
-                    p = p.with_cells(vtk::CellKind::Tet4, &f.tet_conn);
-                }
-                p.with_point_data("u", vtk::FieldData::Vector(&f.u))
-                    .with_point_data("v", vtk::FieldData::Vector(&f.v))
-                    .with_cell_data("cauchy", vtk::FieldData::Tensor(&f.cauchy))
-                    .with_cell_data("von_mises", vtk::FieldData::Scalar(&f.mises))
-                    .with_cell_data("J", vtk::FieldData::Scalar(&f.jac))
-            })
-            .collect();
-        let surfaces: Vec<ContactFrame> = view
-            .problem
-            .contacts
-            .iter()
-            .zip(view.contact)
-            .map(|(pair, nodes)| contact_frame(pair, nodes, view))
-            .collect();
-        let mut pieces = pieces;
-        for c in &surfaces {
-            pieces.push(
-                vtk::Piece::new(&c.points)
-                    .with_cells(vtk::CellKind::Vertex, &c.vertices)
-                    .with_point_data("beta", vtk::FieldData::Scalar(&c.beta))
-                    .with_point_data("rn", vtk::FieldData::Scalar(&c.rn))
-                    .with_point_data("rn_dry", vtk::FieldData::Scalar(&c.rn_dry))
-                    .with_point_data("rn_adh", vtk::FieldData::Scalar(&c.rn_adh))
-                    .with_point_data("rt", vtk::FieldData::Vector(&c.rt))
-                    .with_point_data("rt_adh", vtk::FieldData::Vector(&c.rt_adh))
-                    .with_point_data("contact_force", vtk::FieldData::Vector(&c.force))
-                    .with_point_data("gap", vtk::FieldData::Scalar(&c.gap))
-                    .with_point_data("slip", vtk::FieldData::Scalar(&c.slip))
-                    .with_point_data("ut", vtk::FieldData::Vector(&c.ut))
-                    .with_point_data("state", vtk::FieldData::Int(&c.state)),
-            );
+        let stem = format!("{}_{:05}", self.name, self.frames);
+        let mut bodies = Vec::new();
+        for (i, f) in body_frames(view).iter().enumerate() {
+            let mut p = vtk::Piece::new(&f.points);
+            if !f.hex_conn.is_empty() {
+                p = p.with_cells(vtk::CellKind::Hex8, &f.hex_conn);
+            }
+            if !f.tet_conn.is_empty() {
+                p = p.with_cells(vtk::CellKind::Tet4, &f.tet_conn);
+            }
+            let p = p
+                .with_point_data("u", vtk::FieldData::Vector(&f.u))
+                .with_point_data("v", vtk::FieldData::Vector(&f.v))
+                .with_point_data("node_id", vtk::FieldData::Int(&f.node_id))
+                .with_cell_data("cauchy", vtk::FieldData::Tensor(&f.cauchy))
+                .with_cell_data("von_mises", vtk::FieldData::Scalar(&f.mises))
+                .with_cell_data("J", vtk::FieldData::Scalar(&f.jac))
+                .with_cell_data("body_id", vtk::FieldData::Int(&f.body_id));
+            let file = format!("{stem}_body{i}.vtu");
+            vtk::write_vtu(&self.dir.join("vtu").join(&file), &[p])?;
+            bodies.push((view.problem.bodies[i].name.clone(), file));
         }
-        let rel = format!("vtu/{}_{:05}.vtu", self.name, self.frames);
-        vtk::write_vtu(&self.dir.join(&rel), &pieces)?;
+        let mut contacts = Vec::new();
+        for (j, (pair, nodes)) in view.problem.contacts.iter().zip(view.contact).enumerate() {
+            let c = contact_frame(j, pair, nodes, view);
+            let mut p = vtk::Piece::new(&c.points);
+            if !c.quads.is_empty() {
+                p = p.with_cells(vtk::CellKind::Quad4, &c.quads);
+            }
+            if !c.triangles.is_empty() {
+                p = p.with_cells(vtk::CellKind::Tri3, &c.triangles);
+            }
+            if !c.vertices.is_empty() {
+                p = p.with_cells(vtk::CellKind::Vertex, &c.vertices);
+            }
+            let p = p
+                .with_point_data("node_id", vtk::FieldData::Int(&c.node_id))
+                .with_point_data("area", vtk::FieldData::Scalar(&pair.slave_area))
+                .with_point_data("beta", vtk::FieldData::Scalar(&c.beta))
+                .with_point_data("rn", vtk::FieldData::Scalar(&c.rn))
+                .with_point_data("rn_dry", vtk::FieldData::Scalar(&c.rn_dry))
+                .with_point_data("rn_adh", vtk::FieldData::Scalar(&c.rn_adh))
+                .with_point_data("rt", vtk::FieldData::Vector(&c.rt))
+                .with_point_data("rt_adh", vtk::FieldData::Vector(&c.rt_adh))
+                .with_point_data("contact_force", vtk::FieldData::Vector(&c.force))
+                .with_point_data("pn", vtk::FieldData::Scalar(&c.pn))
+                .with_point_data("pn_adh", vtk::FieldData::Scalar(&c.pn_adh))
+                .with_point_data("tt", vtk::FieldData::Vector(&c.tt))
+                .with_point_data("tt_adh", vtk::FieldData::Vector(&c.tt_adh))
+                .with_point_data("traction", vtk::FieldData::Vector(&c.traction))
+                .with_point_data("gap", vtk::FieldData::Scalar(&c.gap))
+                .with_point_data("slip", vtk::FieldData::Scalar(&c.slip))
+                .with_point_data("ut", vtk::FieldData::Vector(&c.ut))
+                .with_point_data("state", vtk::FieldData::Int(&c.state))
+                .with_cell_data("pair_id", vtk::FieldData::Int(&c.pair_id))
+                .with_cell_data("body_id", vtk::FieldData::Int(&c.body_id));
+            let file = format!("{stem}_contact{j}.vtu");
+            vtk::write_vtu(&self.dir.join("vtu").join(&file), &[p])?;
+            contacts.push((pair.name.clone(), file));
+        }
+        let mut groups = vec![vtk::VtmGroup {
+            name: "bodies".into(),
+            datasets: bodies,
+        }];
+        if !contacts.is_empty() {
+            groups.push(vtk::VtmGroup {
+                name: "contacts".into(),
+                datasets: contacts,
+            });
+        }
+        let rel = format!("vtu/{stem}.vtm");
+        vtk::write_vtm(&self.dir.join(&rel), &groups)?;
         self.pvd.push(t, &rel)?;
         self.frames += 1;
         Ok(())
     }
 }
 
-/// Point data of one contact surface.
+/// A node, body or pair index as a VTK integer (indices beyond `i32::MAX` are not expected:
+/// the mesh generator caps the number of cells far below).
+fn id_i32(i: usize) -> i32 {
+    i32::try_from(i).unwrap_or(i32::MAX)
+}
+
+/// Traction [Pa]: a nodal force [N] over the node's tributary area [m²] (0 for a node
+/// without area).
+pub fn traction(force: f64, area: f64) -> f64 {
+    if area > 0.0 {
+        force / area
+    } else {
+        0.0
+    }
+}
+
+/// Point and cell data of one contact surface.
 struct ContactFrame {
     points: Vec<[f64; 3]>,
+    quads: Vec<usize>,
+    triangles: Vec<usize>,
     vertices: Vec<usize>,
+    node_id: Vec<i32>,
     beta: Vec<f64>,
     rn: Vec<f64>,
     rn_dry: Vec<f64>,
@@ -266,26 +334,60 @@ struct ContactFrame {
     rt: Vec<[f64; 3]>,
     rt_adh: Vec<[f64; 3]>,
     force: Vec<[f64; 3]>,
+    pn: Vec<f64>,
+    pn_adh: Vec<f64>,
+    tt: Vec<[f64; 3]>,
+    tt_adh: Vec<[f64; 3]>,
+    traction: Vec<[f64; 3]>,
     gap: Vec<f64>,
     slip: Vec<f64>,
     ut: Vec<[f64; 3]>,
     state: Vec<i32>,
+    pair_id: Vec<i32>,
+    body_id: Vec<i32>,
 }
 
 fn contact_frame(
+    index: usize,
     pair: &crate::contact::ContactPair,
     nodes: &[NodeContact],
     view: &StepView,
 ) -> ContactFrame {
     let u = &view.state.u;
     let x = &view.disc.reference;
+    let (mut quads, mut triangles) = (Vec::new(), Vec::new());
+    let mut on_face = vec![false; pair.slave_nodes.len()];
+    for q in &pair.slave_quads {
+        if q[3] == q[2] {
+            triangles.extend_from_slice(&q[..3]);
+        } else {
+            quads.extend_from_slice(q);
+        }
+        for &i in q {
+            on_face[i] = true;
+        }
+    }
+    let vertices: Vec<usize> = (0..on_face.len()).filter(|&i| !on_face[i]).collect();
+    let n_cells = quads.len() / 4 + triangles.len() / 3 + vertices.len();
+    let slave_body = pair.slave_nodes.first().map_or(0, |&n| {
+        view.disc
+            .node_offset
+            .iter()
+            .rposition(|&off| off <= n)
+            .unwrap_or(0)
+    });
+    let area = &pair.slave_area;
+    let per_area = |v: [f64; 3], a: f64| -> [f64; 3] { v.map(|c| traction(c, a)) };
     let mut f = ContactFrame {
         points: pair
             .slave_nodes
             .iter()
             .map(|&n| std::array::from_fn(|k| x[n][k] + u[3 * n + k]))
             .collect(),
-        vertices: (0..pair.slave_nodes.len()).collect(),
+        quads,
+        triangles,
+        vertices,
+        node_id: pair.slave_nodes.iter().map(|&n| id_i32(n)).collect(),
         beta: nodes.iter().map(|c| c.beta).collect(),
         rn: nodes.iter().map(|c| c.r_dry[2] + c.r_adh[2]).collect(),
         rn_dry: nodes.iter().map(|c| c.r_dry[2]).collect(),
@@ -293,6 +395,11 @@ fn contact_frame(
         rt: Vec::new(),
         rt_adh: Vec::new(),
         force: nodes.iter().map(|c| c.force).collect(),
+        pn: Vec::new(),
+        pn_adh: Vec::new(),
+        tt: Vec::new(),
+        tt_adh: Vec::new(),
+        traction: Vec::new(),
         gap: nodes.iter().map(|c| c.gap).collect(),
         slip: nodes
             .iter()
@@ -300,13 +407,22 @@ fn contact_frame(
             .collect(),
         ut: nodes.iter().map(|c| c.ut).collect(),
         state: nodes.iter().map(|c| c.state).collect(),
+        pair_id: vec![id_i32(index); n_cells],
+        body_id: vec![id_i32(slave_body); n_cells],
     };
-    for c in nodes {
+    for (c, &a) in nodes.iter().zip(area) {
         let t = c.tangent_axes;
         let g =
             |v: [f64; 2]| -> [f64; 3] { std::array::from_fn(|k| v[0] * t[0][k] + v[1] * t[1][k]) };
-        f.rt.push(g([c.r_dry[0] + c.r_adh[0], c.r_dry[1] + c.r_adh[1]]));
-        f.rt_adh.push(g([c.r_adh[0], c.r_adh[1]]));
+        let rt = g([c.r_dry[0] + c.r_adh[0], c.r_dry[1] + c.r_adh[1]]);
+        let rt_adh = g([c.r_adh[0], c.r_adh[1]]);
+        f.pn.push(traction(c.r_dry[2] + c.r_adh[2], a));
+        f.pn_adh.push(traction(c.r_adh[2], a));
+        f.tt.push(per_area(rt, a));
+        f.tt_adh.push(per_area(rt_adh, a));
+        f.traction.push(per_area(c.force, a));
+        f.rt.push(rt);
+        f.rt_adh.push(rt_adh);
     }
     f
 }
@@ -346,8 +462,27 @@ pub fn history_columns(problem: &Problem) -> Vec<String> {
         c.push(f.into());
     }
     for pair in &problem.contacts {
-        for f in ["fx", "fy", "fz", "fn", "fn_adh", "ft", "ft_adh", "bonded"] {
+        for f in PAIR_TOTAL_FIELDS {
             c.push(format!("{}.{f}", pair.name));
+        }
+    }
+    for (name, d) in reported_boundaries(problem) {
+        for f in REACTION_FIELDS {
+            c.push(format!("{name}.{f}"));
+        }
+        c.extend(prescribed_columns(d.components, d.rotation.is_some(), name));
+    }
+    for pair in &problem.contacts {
+        if let Master::Rigid { motion, .. } = &pair.master {
+            let owner = format!("{}.master", pair.name);
+            for f in REACTION_FIELDS {
+                c.push(format!("{owner}.{f}"));
+            }
+            c.extend(prescribed_columns(
+                [true; 3],
+                motion.rotation.is_some(),
+                &owner,
+            ));
         }
     }
     for tr in &problem.tracks {
@@ -368,26 +503,173 @@ pub fn history_columns(problem: &Problem) -> Vec<String> {
     c
 }
 
-/// Contact fields of one slave node, as written for tracked nodes in the history and in the
-/// contact maps; [`contact_node_values`] gives them in this order.
-pub const CONTACT_NODE_FIELDS: [&str; 9] = [
-    "beta", "rn", "rn_dry", "rn_adh", "rt", "rt_adh", "gap", "slip", "state",
+/// Per-pair columns of the history, `<pair>.<field>`, in the order of [`pair_totals`].
+pub const PAIR_TOTAL_FIELDS: [&str; 14] = [
+    "fx",
+    "fy",
+    "fz",
+    "fn",
+    "fn_adh",
+    "ft_x",
+    "ft_y",
+    "ft_z",
+    "ft_adh_x",
+    "ft_adh_y",
+    "ft_adh_z",
+    "ft_norm_sum",
+    "ft_adh_norm_sum",
+    "bonded",
 ];
 
-/// The [`CONTACT_NODE_FIELDS`] of one slave node: β, total, dry and adhesive normal force
-/// [N], norms of the total and adhesive tangential force [N], gap [m], slip of the step [m]
-/// and state code.
-pub fn contact_node_values(c: &NodeContact) -> [f64; 9] {
+/// Totals of a pair's contact forces on its slave nodes, in the order of
+/// [`PAIR_TOTAL_FIELDS`]: the resultant contact force (global components) [N]; the sums of
+/// the nodal normal forces and of their adhesive parts [N] (signed, > 0 compression); the
+/// resultant tangential force and the resultant adhesive tangential force (global
+/// components) [N]; the sums of the norms of the nodal tangential forces and of their
+/// adhesive parts [N] (a measure of how much tangential force the interface carries, not a
+/// force: opposite nodal forces add up here and cancel in the resultant); the number of
+/// nodes with β > 0.
+pub fn pair_totals(nodes: &[NodeContact]) -> [f64; 14] {
+    let mut out = [0.0; 14];
+    for c in nodes {
+        let t = c.tangent_axes;
+        let global =
+            |a: f64, b: f64| -> [f64; 3] { std::array::from_fn(|k| a * t[0][k] + b * t[1][k]) };
+        let rt = global(c.r_dry[0] + c.r_adh[0], c.r_dry[1] + c.r_adh[1]);
+        let rt_adh = global(c.r_adh[0], c.r_adh[1]);
+        for k in 0..3 {
+            out[k] += c.force[k];
+            out[5 + k] += rt[k];
+            out[8 + k] += rt_adh[k];
+        }
+        out[3] += c.r_dry[2] + c.r_adh[2];
+        out[4] += c.r_adh[2];
+        out[11] += (c.r_dry[0] + c.r_adh[0]).hypot(c.r_dry[1] + c.r_adh[1]);
+        out[12] += c.r_adh[0].hypot(c.r_adh[1]);
+        if c.beta > 0.0 {
+            out[13] += 1.0;
+        }
+    }
+    out
+}
+
+/// Resultant force and moment columns of a reaction: `<owner>.Fx` ... `<owner>.Mz`.
+pub const REACTION_FIELDS: [&str; 6] = ["Fx", "Fy", "Fz", "Mx", "My", "Mz"];
+
+/// The boundaries whose reactions are written, with their names.
+fn reported_boundaries(problem: &Problem) -> impl Iterator<Item = (&str, &Dirichlet)> {
+    problem
+        .output
+        .boundary_names
+        .iter()
+        .zip(&problem.dirichlet)
+        .filter(|(name, _)| !name.is_empty())
+        .map(|(name, d)| (name.as_str(), d))
+}
+
+/// Columns of the prescribed motion of a reaction's owner: `.ux`, `.uy`, `.uz` for the
+/// prescribed translation components [m], then `.angle` [rad] and `.torque` (moment about
+/// the rotation axis [N·m]) when it rotates.
+fn prescribed_columns(components: [bool; 3], rotates: bool, owner: &str) -> Vec<String> {
+    let mut c: Vec<String> = ["ux", "uy", "uz"]
+        .iter()
+        .zip(components)
+        .filter(|(_, on)| *on)
+        .map(|(f, _)| format!("{owner}.{f}"))
+        .collect();
+    if rotates {
+        c.push(format!("{owner}.angle"));
+        c.push(format!("{owner}.torque"));
+    }
+    c
+}
+
+/// Mean of a set of points [m] (the origin for none).
+pub fn centroid(points: impl Iterator<Item = [f64; 3]>) -> [f64; 3] {
+    let (mut sum, mut n) = ([0.0; 3], 0usize);
+    for p in points {
+        for k in 0..3 {
+            sum[k] += p[k];
+        }
+        n += 1;
+    }
+    sum.map(|s| s / n.max(1) as f64)
+}
+
+/// Resultant force [N] and moment about `about` [N·m] of point forces given as
+/// (application point [m], force [N]): F = Σ f, M = Σ (x − about) × f.
+pub fn resultant_and_moment(
+    forces: impl Iterator<Item = ([f64; 3], [f64; 3])>,
+    about: [f64; 3],
+) -> ([f64; 3], [f64; 3]) {
+    let (mut force, mut moment) = ([0.0; 3], [0.0; 3]);
+    for (x, f) in forces {
+        let r: [f64; 3] = std::array::from_fn(|k| x[k] - about[k]);
+        let m = [
+            r[1] * f[2] - r[2] * f[1],
+            r[2] * f[0] - r[0] * f[2],
+            r[0] * f[1] - r[1] * f[0],
+        ];
+        for k in 0..3 {
+            force[k] += f[k];
+            moment[k] += m[k];
+        }
+    }
+    (force, moment)
+}
+
+/// The point of a rigid master about which its moment is taken, in its reference position:
+/// the plane's or cylinder's `point`, the sphere's `center`.
+pub fn shape_reference_point(shape: &RigidShape) -> [f64; 3] {
+    match shape {
+        RigidShape::Plane { point, .. } | RigidShape::Cylinder { point, .. } => *point,
+        RigidShape::Sphere { center, .. } => *center,
+    }
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn unit(a: [f64; 3]) -> [f64; 3] {
+    let n = dot(a, a).sqrt();
+    if n > 0.0 {
+        a.map(|c| c / n)
+    } else {
+        a
+    }
+}
+
+/// Contact fields of one slave node, as written for tracked nodes in the history and in the
+/// contact maps; [`contact_node_values`] gives them in this order.
+pub const CONTACT_NODE_FIELDS: [&str; 13] = [
+    "beta", "rn", "rn_dry", "rn_adh", "rt", "rt_adh", "gap", "slip", "state", "pn", "pn_adh", "tt",
+    "tt_adh",
+];
+
+/// The [`CONTACT_NODE_FIELDS`] of one slave node of tributary area `area` [m²]: β, total,
+/// dry and adhesive normal force [N], norms of the total and adhesive tangential force [N],
+/// gap [m], slip of the step [m], state code, then the same forces as tractions [Pa]:
+/// contact pressure, adhesive normal traction, norms of the total and adhesive tangential
+/// tractions.
+pub fn contact_node_values(c: &NodeContact, area: f64) -> [f64; 13] {
+    let rn = c.r_dry[2] + c.r_adh[2];
+    let rt = (c.r_dry[0] + c.r_adh[0]).hypot(c.r_dry[1] + c.r_adh[1]);
+    let rt_adh = c.r_adh[0].hypot(c.r_adh[1]);
     [
         c.beta,
-        c.r_dry[2] + c.r_adh[2],
+        rn,
         c.r_dry[2],
         c.r_adh[2],
-        (c.r_dry[0] + c.r_adh[0]).hypot(c.r_dry[1] + c.r_adh[1]),
-        c.r_adh[0].hypot(c.r_adh[1]),
+        rt,
+        rt_adh,
         c.gap,
         c.slip[0].hypot(c.slip[1]),
         c.state as f64,
+        traction(rn, area),
+        traction(c.r_adh[2], area),
+        traction(rt, area),
+        traction(rt_adh, area),
     ]
 }
 
@@ -453,31 +735,145 @@ impl Observer for HistoryObserver {
         let tm = &r.timings;
         row.extend_from_slice(&[tm.assembly, tm.factorisation, tm.delassus, tm.contact_solve]);
         for nodes in view.contact {
-            let mut total = [0.0; 3];
-            let (mut fn_, mut fn_adh, mut ft, mut ft_adh, mut bonded) = (0.0, 0.0, 0.0, 0.0, 0.0);
-            for c in nodes {
-                for k in 0..3 {
-                    total[k] += c.force[k];
-                }
-                fn_ += c.r_dry[2] + c.r_adh[2];
-                fn_adh += c.r_adh[2];
-                ft += (c.r_dry[0] + c.r_adh[0]).hypot(c.r_dry[1] + c.r_adh[1]);
-                ft_adh += c.r_adh[0].hypot(c.r_adh[1]);
-                if c.beta > 0.0 {
-                    bonded += 1.0;
+            row.extend_from_slice(&pair_totals(nodes));
+        }
+        let x = &view.disc.reference;
+        let u = &view.state.u;
+        let t = view.state.t;
+        let current = |n: usize| -> [f64; 3] { std::array::from_fn(|k| x[n][k] + u[3 * n + k]) };
+        for (_, d) in reported_boundaries(view.problem) {
+            let about = centroid(d.nodes.iter().map(|&n| x[n]));
+            let (force, moment) = resultant_and_moment(
+                d.nodes.iter().map(|&n| {
+                    let r = &view.reactions[3 * n..3 * n + 3];
+                    (current(n), [r[0], r[1], r[2]])
+                }),
+                about,
+            );
+            row.extend_from_slice(&force);
+            row.extend_from_slice(&moment);
+            for k in 0..3 {
+                if d.components[k] {
+                    row.push(d.translation[k].at(t));
                 }
             }
-            row.extend_from_slice(&total);
-            row.extend_from_slice(&[fn_, fn_adh, ft, ft_adh, bonded]);
+            if let Some(r) = &d.rotation {
+                row.push(r.angle.at(t));
+                row.push(dot(moment, unit(r.axis)));
+            }
+        }
+        for (pair, nodes) in view.problem.contacts.iter().zip(view.contact) {
+            if let Master::Rigid { shape, motion } = &pair.master {
+                let about = motion.apply(shape_reference_point(shape), t);
+                let (force, moment) = resultant_and_moment(
+                    pair.slave_nodes
+                        .iter()
+                        .zip(nodes)
+                        .map(|(&n, c)| (current(n), c.force.map(|f| -f))),
+                    about,
+                );
+                row.extend_from_slice(&force);
+                row.extend_from_slice(&moment);
+                for k in 0..3 {
+                    row.push(motion.translation[k].at(t));
+                }
+                if let Some(r) = &motion.rotation {
+                    row.push(r.angle.at(t));
+                    row.push(dot(moment, unit(r.axis)));
+                }
+            }
         }
         for tr in &view.problem.tracks {
             let n = tr.node;
             row.extend_from_slice(&view.state.u[3 * n..3 * n + 3]);
             row.extend_from_slice(&view.state.v[3 * n..3 * n + 3]);
             for (p, i) in track_contacts(view.problem, n) {
-                row.extend_from_slice(&contact_node_values(&view.contact[p][i]));
+                let area = view.problem.contacts[p].slave_area[i];
+                row.extend_from_slice(&contact_node_values(&view.contact[p][i], area));
             }
         }
         self.writer.append(&row)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_files_are_recognised_by_their_number() {
+        assert_eq!(frame_file_index("00012.vtm"), Some(12));
+        assert_eq!(frame_file_index("00012.vtu"), Some(12));
+        assert_eq!(frame_file_index("00012_body0.vtu"), Some(12));
+        assert_eq!(frame_file_index("123456_contact3.vtu"), Some(123456));
+        for other in [
+            "0012.vtm",
+            "00012.csv",
+            "00012_.vtu",
+            "x0012.vtm",
+            "00012_body0.vtm",
+        ] {
+            assert_eq!(frame_file_index(other), None, "{other}");
+        }
+    }
+
+    /// A couple (equal and opposite forces 2 m apart) has no resultant and a moment of
+    /// force × arm whatever the point; a single force has r × f about another point.
+    #[test]
+    fn resultant_and_moment_of_a_couple_and_of_a_single_force() {
+        let couple = [
+            ([1.0, 0.0, 0.0], [0.0, 3.0, 0.0]),
+            ([-1.0, 0.0, 0.0], [0.0, -3.0, 0.0]),
+        ];
+        for about in [[0.0; 3], [5.0, -2.0, 7.0]] {
+            let (f, m) = resultant_and_moment(couple.into_iter(), about);
+            assert_eq!(f, [0.0; 3]);
+            assert_eq!(m, [0.0, 0.0, 6.0]);
+        }
+        let (f, m) =
+            resultant_and_moment([([0.0, 2.0, 0.0], [4.0, 0.0, 0.0])].into_iter(), [0.0; 3]);
+        assert_eq!(f, [4.0, 0.0, 0.0]);
+        assert_eq!(m, [0.0, 0.0, -8.0]);
+        assert_eq!(
+            centroid([[0.0, 0.0, 0.0], [2.0, 4.0, 6.0]].into_iter()),
+            [1.0, 2.0, 3.0]
+        );
+    }
+
+    /// Two nodes with opposite tangential forces of 3 N (one of them adhesive) and normal
+    /// forces 2 N and 5 N: the resultant tangential force is zero, the sum of norms 6 N.
+    #[test]
+    fn pair_totals_separate_the_resultant_from_the_sum_of_norms() {
+        let axes = [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0]];
+        let a = NodeContact {
+            r_dry: [3.0, 0.0, 2.0],
+            force: [0.0, 2.0, 3.0],
+            tangent_axes: axes,
+            beta: 0.5,
+            ..Default::default()
+        };
+        let b = NodeContact {
+            r_adh: [-3.0, 0.0, 5.0],
+            force: [0.0, 5.0, -3.0],
+            tangent_axes: axes,
+            ..Default::default()
+        };
+        let t = pair_totals(&[a, b]);
+        let get = |name: &str| t[PAIR_TOTAL_FIELDS.iter().position(|f| *f == name).unwrap()];
+        assert_eq!([get("fx"), get("fy"), get("fz")], [0.0, 7.0, 0.0]);
+        assert_eq!([get("ft_x"), get("ft_y"), get("ft_z")], [0.0; 3]);
+        assert_eq!(
+            [get("ft_adh_x"), get("ft_adh_y"), get("ft_adh_z")],
+            [0.0, 0.0, -3.0]
+        );
+        assert_eq!(get("ft_norm_sum"), 6.0);
+        assert_eq!(get("ft_adh_norm_sum"), 3.0);
+        assert_eq!((get("fn"), get("fn_adh"), get("bonded")), (7.0, 5.0, 1.0));
+    }
+
+    #[test]
+    fn traction_is_force_over_area_and_zero_without_area() {
+        assert_eq!(traction(3.0, 0.5), 6.0);
+        assert_eq!(traction(3.0, 0.0), 0.0);
     }
 }

@@ -1,4 +1,5 @@
-//! VTK XML output: unstructured grids (`.vtu`) and ParaView time collections (`.pvd`).
+//! VTK XML output: unstructured grids (`.vtu`), multiblock files grouping them (`.vtm`,
+//! [`write_vtm`]) and ParaView time collections (`.pvd`).
 //!
 //! # File format
 //!
@@ -20,7 +21,9 @@
 //!
 //! # Several pieces
 //!
-//! A file may hold several pieces (for example each body and the contact surface). Point and
+//! A file may hold several pieces. The run's frames do not use this (they write one grid per
+//! body and per contact surface, grouped by a `.vtm`, since meshio keeps only the cells of
+//! the last piece and every piece must carry every array). Point and
 //! cell indices are local to each piece. Readers (ParaView, meshio) expect every piece to
 //! carry the same arrays, so the file gets the union of the field names of all pieces, in
 //! order of first appearance; a piece lacking a field is padded with `NaN` (real fields) or
@@ -604,6 +607,54 @@ impl PvdWriter {
     }
 }
 
+/// One group of a multiblock file: a name and its data sets, each a name and a file path
+/// relative to the `.vtm` file's directory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VtmGroup {
+    /// Name of the group (shown in ParaView's pipeline browser).
+    pub name: String,
+    /// (data set name, file) pairs.
+    pub datasets: Vec<(String, String)>,
+}
+
+/// Writes a VTK XML multiblock file (`vtkMultiBlockDataSet`, `.vtm`) at `path`, atomically:
+/// one `Block` per group, holding one `DataSet` per file. Every file is written before the
+/// `.vtm` that lists it, so a `.vtm` on disk never lists a missing file.
+///
+/// An empty or control-character name or file is an [`io::ErrorKind::InvalidInput`] error
+/// naming `path`.
+pub fn write_vtm(path: &Path, groups: &[VtmGroup]) -> io::Result<()> {
+    let invalid = |msg: String| {
+        io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!("{}: {msg}", path.display()),
+        )
+    };
+    let mut xml = String::with_capacity(300 + 120 * groups.len());
+    xml.push_str(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"vtkMultiBlockDataSet\" version=\"1.0\" \
+         byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <vtkMultiBlockDataSet>\n",
+    );
+    for (g, group) in groups.iter().enumerate() {
+        check_name(&group.name).map_err(|m| invalid(format!("group {g}: {m}")))?;
+        let _ = write!(xml, "    <Block index=\"{g}\" name=\"");
+        push_escaped(&mut xml, &group.name);
+        xml.push_str("\">\n");
+        for (d, (name, file)) in group.datasets.iter().enumerate() {
+            check_name(name).map_err(|m| invalid(format!("group {g}, data set {d}: {m}")))?;
+            check_name(file).map_err(|m| invalid(format!("group {g}, data set {d}: {m}")))?;
+            let _ = write!(xml, "      <DataSet index=\"{d}\" name=\"");
+            push_escaped(&mut xml, name);
+            xml.push_str("\" file=\"");
+            push_escaped(&mut xml, file);
+            xml.push_str("\"/>\n");
+        }
+        xml.push_str("    </Block>\n");
+    }
+    xml.push_str("  </vtkMultiBlockDataSet>\n</VTKFile>\n");
+    write_atomic(path, xml.as_bytes())
+}
+
 /// Appends a finite time in shortest round-trip form, with an exponent for extreme
 /// magnitudes.
 fn push_time(out: &mut String, t: f64) {
@@ -1098,6 +1149,55 @@ mod tests {
         let path = dir.path().join("nope").join("run.pvd");
         let err = PvdWriter::new(&path).unwrap_err();
         assert!(err.to_string().contains("run.pvd"), "{err}");
+    }
+
+    #[test]
+    fn vtm_lists_groups_and_files_escaped_and_rejects_empty_names() {
+        let dir = TestDir::new("vtm");
+        let path = dir.path().join("frame.vtm");
+        let groups = [
+            VtmGroup {
+                name: "bodies".into(),
+                datasets: vec![("a<b".into(), "f_body0.vtu".into())],
+            },
+            VtmGroup {
+                name: "contacts".into(),
+                datasets: vec![("c\"d".into(), "f_contact0.vtu".into())],
+            },
+        ];
+        write_vtm(&path, &groups).unwrap();
+        let doc = parse_xml(&std::fs::read_to_string(&path).unwrap());
+        assert_eq!(doc.attr("type"), "vtkMultiBlockDataSet");
+        let blocks: Vec<_> = doc
+            .child("vtkMultiBlockDataSet")
+            .children_named("Block")
+            .collect();
+        assert_eq!(blocks.len(), 2);
+        let sets: Vec<(String, String, String)> = blocks
+            .iter()
+            .flat_map(|b| b.children_named("DataSet"))
+            .map(|d| {
+                (
+                    d.attr("index").into(),
+                    unescape(d.attr("name")),
+                    d.attr("file").into(),
+                )
+            })
+            .collect();
+        assert_eq!(
+            sets,
+            [
+                ("0".into(), "a<b".into(), "f_body0.vtu".into()),
+                ("0".into(), "c\"d".into(), "f_contact0.vtu".into())
+            ]
+        );
+        let bad = [VtmGroup {
+            name: "bodies".into(),
+            datasets: vec![(String::new(), "x.vtu".into())],
+        }];
+        let err = write_vtm(&dir.path().join("bad.vtm"), &bad).unwrap_err();
+        assert!(err.to_string().contains("bad.vtm"), "{err}");
+        assert!(!dir.path().join("bad.vtm").exists());
     }
 
     /// Python expression for a list of floats (exact: Rust's `{:?}` round-trips).

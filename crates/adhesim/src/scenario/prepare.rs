@@ -79,6 +79,9 @@ pub struct Prepared {
     /// Whether the document differs from the file as written (then error messages cannot
     /// point at lines).
     pub changed: bool,
+    /// Keys whose expression gave a number with a fractional part, as `key = value`, to
+    /// explain a type error when such a key needs an integer.
+    pub fractional: Vec<String>,
 }
 
 /// Applies `variant`, then `overrides`, then evaluates parameters and expressions, in place.
@@ -130,8 +133,12 @@ pub fn prepare(
         changed = true;
     }
     let mut path = Vec::new();
-    changed |= substitute(doc, &params, &mut path)?;
-    Ok(Prepared { changed })
+    let mut fractional = Vec::new();
+    changed |= substitute(doc, &params, &mut path, &mut fractional)?;
+    Ok(Prepared {
+        changed,
+        fractional,
+    })
 }
 
 /// Sets a dotted key. The key must exist already (a typo would otherwise silently add an
@@ -319,11 +326,12 @@ fn substitute(
     t: &mut Table,
     params: &BTreeMap<String, f64>,
     path: &mut Vec<String>,
+    fractional: &mut Vec<String>,
 ) -> Result<bool, String> {
     let mut changed = false;
     for (k, v) in t.iter_mut() {
         path.push(k.clone());
-        changed |= substitute_value(v, params, path)?;
+        changed |= substitute_value(v, params, path, fractional)?;
         path.pop();
     }
     Ok(changed)
@@ -333,26 +341,42 @@ fn substitute_value(
     v: &mut Value,
     params: &BTreeMap<String, f64>,
     path: &mut Vec<String>,
+    fractional: &mut Vec<String>,
 ) -> Result<bool, String> {
     match v {
         Value::String(s) if s.trim_start().starts_with('=') => {
             let expr = s.trim_start()[1..].to_string();
             let x = eval(&expr, params)
                 .map_err(|e| format!("`{}` = \"={expr}\": {e}", path.join(".")))?;
-            *v = Value::Float(x);
+            *v = number_value(x);
+            if matches!(v, Value::Float(_)) {
+                fractional.push(format!("`{}` = {x}", path.join(".")));
+            }
             Ok(true)
         }
-        Value::Table(t) => substitute(t, params, path),
+        Value::Table(t) => substitute(t, params, path, fractional),
         Value::Array(a) => {
             let mut changed = false;
             for (i, x) in a.iter_mut().enumerate() {
                 path.push(i.to_string());
-                changed |= substitute_value(x, params, path)?;
+                changed |= substitute_value(x, params, path, fractional)?;
                 path.pop();
             }
             Ok(changed)
         }
         _ => Ok(false),
+    }
+}
+
+/// The TOML value of an evaluated expression: an integer when the number is a whole number
+/// that an `i64` holds exactly (so that integer keys such as `divisions` take expressions;
+/// real keys read integers as well), a float otherwise.
+fn number_value(x: f64) -> Value {
+    const EXACT: f64 = 9_007_199_254_740_992.0; // 2^53
+    if x.fract() == 0.0 && x.abs() <= EXACT {
+        Value::Integer(x as i64)
+    } else {
+        Value::Float(x)
     }
 }
 
