@@ -931,6 +931,14 @@ fn newton_step(ctx: &Ctx, ev: &Eval) -> Option<V3> {
     solve3(jac, neg(ev.f)).filter(|d| d.iter().all(|v| v.is_finite()))
 }
 
+/// Generalised Jacobian ∂P_K/∂r* of [`dry_projection`] at `r_star` [-], for the case that
+/// [`dry_projection`] returned there: 0 apart, I sticking, the derivative of the sliding
+/// formula otherwise (at the cone's apex, ‖r*_t‖ = 0, the element (0, 0, 1/(1 + μ²)) on the
+/// diagonal is used).
+pub fn dry_projection_jacobian(r_star: [f64; 3], mu: f64, case: ContactState) -> [[f64; 3]; 3] {
+    projection_jacobian(r_star, mu.max(0.0), case)
+}
+
 /// Jacobian of [`dry_projection`] at `r_star` in the given case.
 fn projection_jacobian(r_star: V3, mu: f64, case: ContactState) -> M3 {
     match case {

@@ -8,6 +8,9 @@
 
 pub mod detect;
 pub mod law;
+pub mod natural_map;
+pub mod reduced;
+pub mod semismooth;
 pub mod solve;
 
 pub use detect::{ContactPair, Master, RigidMotion, RigidShape};
