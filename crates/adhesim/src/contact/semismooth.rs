@@ -13,8 +13,15 @@
 //! = I + μ n (x_t/‖x_t‖, 0)ᵀ (the second term dropped at ‖x_t‖ = 0). The Newton system has the
 //! sparsity of W in 3×3 blocks and is solved by a sparse LU factorisation.
 //!
-//! Globalisation: a backtracking (Armijo) line search on θ = ½‖F‖²; the Newton direction d
-//! solves J d = −F, so θ'(r; d) = −2θ and a step t is accepted when
+//! Regularisation: W is singular whenever there are more contact components than degrees of
+//! freedom (rigid bodies with many contacts), and so is J where such contacts stick. The
+//! Newton matrix therefore uses W + ηI (a proximal, Levenberg–Marquardt-like term), with
+//! η = λ̄ · min(η_rel, e): λ̄ the mean of λ_max(W_αα), e the current relative error, and η_rel
+//! divided by 10 after a full step, multiplied by 10 after a shortened or failed one (within
+//! [10⁻¹², 1]). As e → 0 the step tends to the plain semismooth Newton step.
+//!
+//! Globalisation: a backtracking (Armijo) line search on θ = ½‖F‖²; for the unregularised
+//! direction (J d = −F) θ'(r; d) = −2θ, and a step t is accepted when
 //! θ(r + t d) ≤ (1 − 2σt) θ(r), σ = 10⁻⁴. When the system is singular, its solution is not
 //! finite, or no step down to 2⁻²⁰ is accepted, a nonlinear Gauss–Seidel sweep
 //! ([`gauss_seidel_sweep`]) is taken instead and Newton resumes from there.
@@ -32,6 +39,13 @@ type M3 = [[f64; 3]; 3];
 
 /// Armijo constant σ of the line search.
 const ARMIJO: f64 = 1e-4;
+/// Regularisation η of the Newton matrix, relative to the mean of λ_max(W_αα): its start,
+/// bounds, and the factors applied after a full step and after a shortened or failed one.
+const ETA_START: f64 = 1e-2;
+const ETA_MIN: f64 = 1e-12;
+const ETA_MAX: f64 = 1.0;
+const ETA_DOWN: f64 = 0.1;
+const ETA_UP: f64 = 10.0;
 /// Smallest step length tried before a Gauss–Seidel sweep is taken instead.
 const MIN_STEP: f64 = 1.0 / (1u64 << 20) as f64;
 
@@ -75,6 +89,7 @@ fn newton_direction(
     r: &[[f64; 3]],
     x: &[[f64; 3]],
     f: &[[f64; 3]],
+    eta: f64,
 ) -> Option<Vec<f64>> {
     let n = w.points();
     let mut triplets: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(9 * w.block_count());
@@ -102,7 +117,7 @@ fn newton_direction(
                 for b in 0..3 {
                     let mut v: f64 = (0..3).map(|k| pd[a][k] * wb[k][b]).sum();
                     if j == p {
-                        v += if a == b { 1.0 } else { 0.0 } - jp[a][b];
+                        v += if a == b { 1.0 } else { 0.0 } - jp[a][b] + eta * pd[a][b];
                     }
                     triplets.push(Triplet::new(3 * p + a, 3 * j + b, v));
                 }
@@ -133,6 +148,11 @@ pub fn semismooth_newton(
     let n = w.points();
     assert!(q.len() == n && mu.len() == n && r_start.len() == n);
     let rho = point_rhos(w);
+    let eta_scale = if n > 0 {
+        rho.iter().map(|r| 1.0 / r).sum::<f64>() / n as f64
+    } else {
+        0.0
+    };
     let mut r = r_start.to_vec();
     let mut x = vec![[0.0; 3]; n];
     let mut f = vec![[0.0; 3]; n];
@@ -141,6 +161,7 @@ pub fn semismooth_newton(
     let mut f_try = vec![[0.0; 3]; n];
     let mut counts = NewtonCounts::default();
     let mut iterations = 0;
+    let mut eta_rel = ETA_START;
     let mut theta = natural_map_rho(w, q, mu, &rho, &r, &mut x, &mut f);
     loop {
         let residual = natural_map_residual(&r, &x, mu);
@@ -158,7 +179,8 @@ pub fn semismooth_newton(
         }
         iterations += 1;
         let mut accepted = false;
-        if let Some(d) = newton_direction(w, mu, &rho, &r, &x, &f) {
+        let eta = eta_scale * eta_rel.min(error);
+        if let Some(d) = newton_direction(w, mu, &rho, &r, &x, &f, eta) {
             let mut t = 1.0;
             while t >= MIN_STEP {
                 for p in 0..n {
@@ -173,6 +195,11 @@ pub fn semismooth_newton(
                     std::mem::swap(&mut f, &mut f_try);
                     theta = theta_try;
                     accepted = true;
+                    eta_rel = if t == 1.0 {
+                        (eta_rel * ETA_DOWN).max(ETA_MIN)
+                    } else {
+                        (eta_rel * ETA_UP).min(ETA_MAX)
+                    };
                     counts.newton_steps += 1;
                     break;
                 }
@@ -180,6 +207,7 @@ pub fn semismooth_newton(
             }
         }
         if !accepted {
+            eta_rel = (eta_rel * ETA_UP).min(ETA_MAX);
             gauss_seidel_sweep(w, q, mu, &rho, &mut r);
             counts.fallback_sweeps += 1;
             theta = natural_map_rho(w, q, mu, &rho, &r, &mut x, &mut f);
@@ -261,7 +289,7 @@ mod tests {
             let col: Vec<[f64; 3]> = (0..3)
                 .map(|p| std::array::from_fn(|a| (fp[p][a] - fm[p][a]) / (2.0 * h)))
                 .collect();
-            let d = newton_direction(&w, &mu, &rho, &r, &x, &col).expect("regular");
+            let d = newton_direction(&w, &mu, &rho, &r, &x, &col, 0.0).expect("regular");
             for (i, v) in d.iter().enumerate() {
                 let expect = if i == k { -1.0 } else { 0.0 };
                 assert!((v - expect).abs() < 1e-6, "column {k}, entry {i}: {v}");
