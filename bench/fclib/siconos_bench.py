@@ -7,7 +7,7 @@ Siconos in its 3x3 sparse-block storage. Every solver starts from r = 0. The err
 computed here, the same way as adhesim's: ||F_nat(r)|| / max(||q||, ||r||, ||u||) with
 F_nat(r) = r - P_K(r - (u + mu ||u_T|| N)), u = W r + q, contact by contact.
 
-Usage: siconos_bench.py [--tol T] [--runs N] FILE...
+Usage: siconos_bench.py [--tol T] [--runs N] [--max-iter N] FILE...
 """
 import sys
 import time
@@ -20,7 +20,6 @@ import scipy.sparse as sp
 warnings.simplefilter("ignore")
 import siconos.numerics as sn  # noqa: E402
 
-MAX_ITER = 100_000
 LONG_RUN = 5.0  # s: no further repetition once one run took this long
 
 
@@ -76,7 +75,7 @@ def error(W, q, mu, r):
     return np.sqrt(s) / scale if scale > 0 else np.sqrt(s)
 
 
-def options(name, tol):
+def options(name, tol, max_iter):
     ids = {
         "siconos-nsgs": sn.SICONOS_FRICTION_3D_NSGS,
         "siconos-nsgs-ac": sn.SICONOS_FRICTION_3D_NSGS,
@@ -86,7 +85,7 @@ def options(name, tol):
     }
     so = sn.SolverOptions(ids[name])
     so.dparam[sn.SICONOS_DPARAM_TOL] = tol
-    so.iparam[sn.SICONOS_IPARAM_MAX_ITER] = MAX_ITER
+    so.iparam[sn.SICONOS_IPARAM_MAX_ITER] = max_iter
     if name == "siconos-nsgs-ac":
         # NSGS with the local Alart-Curnier nonsmooth Newton solver.
         sn.solver_options_update_internal(so, 0, sn.SICONOS_FRICTION_3D_ONECONTACT_NSN)
@@ -97,13 +96,15 @@ SOLVERS = ["siconos-nsgs", "siconos-nsgs-ac", "siconos-nsn-ac", "siconos-prox", 
 
 
 def main(argv):
-    tol, runs, files = 1e-8, 5, []
+    tol, runs, max_iter, files = 1e-8, 5, 100_000, []
     it = iter(argv)
     for a in it:
         if a == "--tol":
             tol = float(next(it))
         elif a == "--runs":
             runs = int(next(it))
+        elif a == "--max-iter":
+            max_iter = int(next(it))
         else:
             files.append(a)
     print("file,kind,contacts,solver,converged,error,iterations,time_ms,runs,condense_ms")
@@ -121,7 +122,7 @@ def main(argv):
         for solver in SOLVERS:
             times = []
             for _ in range(runs):
-                so = options(solver, tol)
+                so = options(solver, tol, max_iter)
                 r, u = np.zeros(m), np.zeros(m)
                 t0 = time.perf_counter()
                 sn.fc3d_driver(problem, r, u, so)

@@ -1,7 +1,7 @@
 //! Solves fclib problems with adhesim's contact solvers and prints, per file and solver, the
 //! error measure (Siconos's relative natural-map error), the iterations and the median time.
 //!
-//! Usage: fclib-bench [--tol T] [--runs N] [--solvers a,b,...] FILE...
+//! Usage: fclib-bench [--tol T] [--runs N] [--max-iter N] [--solvers a,b,...] FILE...
 //!
 //! Solvers: `nsgs-dense` (the stepper's Gauss-Seidel on a dense W, `contact::solve`),
 //! `nsgs-blocks` (Gauss-Seidel on W in 3×3 sparse blocks), `newton` (semismooth Newton).
@@ -20,16 +20,16 @@ use adhesim::contact::solve::{gauss_seidel, Delassus};
 use adhesim_fclib::{read, Problem, ReducedProblem};
 
 const SOLVERS: [&str; 3] = ["nsgs-dense", "nsgs-blocks", "newton"];
-/// Largest number of Gauss-Seidel sweeps.
-const MAX_SWEEPS: usize = 100_000;
-/// Largest number of Newton iterations (steps plus fallback sweeps).
-const MAX_NEWTON: usize = 1_000;
+/// Default largest number of iterations (Gauss-Seidel sweeps; Newton steps plus fallback
+/// sweeps).
+const MAX_ITER: usize = 100_000;
 /// No further repetition once one run took this long [s].
 const LONG_RUN: f64 = 5.0;
 
 struct Options {
     tol: f64,
     runs: usize,
+    max_iter: usize,
     solvers: Vec<String>,
     files: Vec<String>,
 }
@@ -38,6 +38,7 @@ fn parse_args() -> Result<Options, String> {
     let mut o = Options {
         tol: 1e-8,
         runs: 5,
+        max_iter: MAX_ITER,
         solvers: SOLVERS.iter().map(|s| s.to_string()).collect(),
         files: Vec::new(),
     };
@@ -61,6 +62,14 @@ fn parse_args() -> Result<Options, String> {
                     .filter(|n: &usize| *n > 0)
                     .ok_or(format!("--runs {v}: a positive integer expected"))?;
             }
+            "--max-iter" => {
+                let v = value("--max-iter")?;
+                o.max_iter = v
+                    .parse()
+                    .ok()
+                    .filter(|n: &usize| *n > 0)
+                    .ok_or(format!("--max-iter {v}: a positive integer expected"))?;
+            }
             "--solvers" => {
                 let v = value("--solvers")?;
                 o.solvers = v.split(',').map(str::to_string).collect();
@@ -73,7 +82,7 @@ fn parse_args() -> Result<Options, String> {
             }
             "-h" | "--help" => {
                 return Err(
-                    "usage: fclib-bench [--tol T] [--runs N] [--solvers nsgs-dense,nsgs-blocks,newton] FILE..."
+                    "usage: fclib-bench [--tol T] [--runs N] [--max-iter N] [--solvers nsgs-dense,nsgs-blocks,newton] FILE..."
                         .into(),
                 )
             }
@@ -89,7 +98,7 @@ fn parse_args() -> Result<Options, String> {
 
 /// Gauss-Seidel of the stepper (`contact::solve::gauss_seidel`) on a dense W, one sweep per
 /// call so that Siconos's error can be checked after each sweep (the warm start carries r).
-fn nsgs_dense(p: &ReducedProblem, del: &Delassus, tol: f64) -> ReducedSolution {
+fn nsgs_dense(p: &ReducedProblem, del: &Delassus, tol: f64, max_iter: usize) -> ReducedSolution {
     let n = p.w.points();
     let points: Vec<ContactPoint> = (0..n)
         .map(|k| ContactPoint {
@@ -112,7 +121,7 @@ fn nsgs_dense(p: &ReducedProblem, del: &Delassus, tol: f64) -> ReducedSolution {
     let mut x = vec![[0.0; 3]; n];
     let (mut residual, mut error) = error_of(&p.w, &p.q, &p.mu, &r, &mut x);
     let mut sweeps = 0;
-    while error > tol && sweeps < MAX_SWEEPS {
+    while error > tol && sweeps < max_iter {
         let sol = gauss_seidel(&points, &laws, &bond0, 1.0, del, &p.q, &r, &r, 0.0, 1);
         r = sol.points.iter().map(|s| s.r_dry).collect();
         sweeps += 1;
@@ -128,12 +137,12 @@ fn nsgs_dense(p: &ReducedProblem, del: &Delassus, tol: f64) -> ReducedSolution {
     }
 }
 
-fn solve(name: &str, p: &ReducedProblem, del: &Delassus, tol: f64) -> ReducedSolution {
+fn solve(name: &str, p: &ReducedProblem, del: &Delassus, o: &Options) -> ReducedSolution {
     let r0 = vec![[0.0; 3]; p.w.points()];
     match name {
-        "nsgs-dense" => nsgs_dense(p, del, tol),
-        "nsgs-blocks" => gauss_seidel_blocks(&p.w, &p.q, &p.mu, &r0, tol, MAX_SWEEPS),
-        "newton" => semismooth_newton(&p.w, &p.q, &p.mu, &r0, tol, MAX_NEWTON).0,
+        "nsgs-dense" => nsgs_dense(p, del, o.tol, o.max_iter),
+        "nsgs-blocks" => gauss_seidel_blocks(&p.w, &p.q, &p.mu, &r0, o.tol, o.max_iter),
+        "newton" => semismooth_newton(&p.w, &p.q, &p.mu, &r0, o.tol, o.max_iter).0,
         _ => unreachable!("solver names are checked when parsing"),
     }
 }
@@ -197,7 +206,7 @@ fn main() -> ExitCode {
             let mut last = None;
             for _ in 0..o.runs {
                 let t = Instant::now();
-                let sol = solve(solver, &problem, &del, o.tol);
+                let sol = solve(solver, &problem, &del, &o);
                 let dt = t.elapsed().as_secs_f64();
                 times.push(dt);
                 last = Some(sol);
