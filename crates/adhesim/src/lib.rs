@@ -19,6 +19,7 @@ pub mod problem;
 pub mod run;
 pub mod scenario;
 pub mod sweep;
+pub mod system;
 pub mod time;
 pub mod warnings;
 

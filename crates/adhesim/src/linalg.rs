@@ -56,6 +56,11 @@ impl BlockPattern {
             list.sort_unstable();
             list.dedup();
         }
+        Self::from_neighbours(num_nodes, nbrs)
+    }
+
+    /// The pattern of sorted upper neighbour lists (each node's list ends with itself).
+    fn from_neighbours(num_nodes: usize, nbrs: Vec<Vec<usize>>) -> Self {
         let n = 3 * num_nodes;
         let mut col_ptr = Vec::with_capacity(n + 1);
         let mut row_idx = Vec::new();
@@ -77,6 +82,36 @@ impl BlockPattern {
             col_ptr,
             row_idx,
         }
+    }
+
+    /// This pattern with the extra node couplings `pairs` (any order, repeats allowed), and
+    /// for each stored value of `self` its position in the new pattern.
+    pub fn with_extra_pairs(&self, pairs: &[(usize, usize)]) -> (BlockPattern, Vec<usize>) {
+        let mut nbrs = self.upper_neighbours.clone();
+        for &(a, b) in pairs {
+            let (lo, hi) = (a.min(b), a.max(b));
+            nbrs[hi].push(lo);
+        }
+        for list in nbrs.iter_mut() {
+            list.sort_unstable();
+            list.dedup();
+        }
+        let ext = BlockPattern::from_neighbours(self.num_nodes, nbrs);
+        let mut map = vec![0usize; self.nnz()];
+        for b in 0..self.num_nodes {
+            for (r, &a) in self.upper_neighbours[b].iter().enumerate() {
+                let r_ext = ext
+                    .rank(a, b)
+                    .expect("the extended pattern holds the original");
+                for k in 0..3 {
+                    let rows = if a == b { k + 1 } else { 3 };
+                    for i in 0..rows {
+                        map[self.position(r, b, i, k)] = ext.position(r_ext, b, i, k);
+                    }
+                }
+            }
+        }
+        (ext, map)
     }
 
     /// Number of stored values.
@@ -373,6 +408,25 @@ mod tests {
             .map(|(a, t)| (a - t).abs())
             .fold(0.0, f64::max);
         assert!(err < 1e-12, "max error {err}");
+    }
+
+    #[test]
+    fn extra_pairs_keep_every_value_in_place() {
+        let (p, values) = chain_matrix(6);
+        let (ext, map) = p.with_extra_pairs(&[(5, 0), (2, 4), (0, 5)]);
+        assert_eq!(ext.nnz(), p.nnz() + 2 * 9);
+        assert!(ext.rank(0, 5).is_some() && ext.rank(2, 4).is_some());
+        let mut ext_values = vec![0.0; ext.nnz()];
+        for (q, &v) in values.iter().enumerate() {
+            assert_eq!(ext.row_idx[map[q]], p.row_idx[q]);
+            ext_values[map[q]] = v;
+        }
+        // Same matrix, so the same product.
+        let x: Vec<f64> = (0..18).map(|i| (i as f64 * 0.37).sin()).collect();
+        let (mut y0, mut y1) = (vec![0.0; 18], vec![0.0; 18]);
+        p.symmetric_matvec(&values, &x, &mut y0);
+        ext.symmetric_matvec(&ext_values, &x, &mut y1);
+        assert_eq!(y0, y1);
     }
 
     #[test]

@@ -141,6 +141,23 @@ pub struct TimeSettings {
     pub lumped_mass: bool,
     /// Rayleigh damping A = alpha_m M + beta_k K₀ [1/s], [s].
     pub rayleigh: (f64, f64),
+    /// How the contact conditions are solved.
+    pub contact_solver: ContactSolver,
+    /// Tolerance on the contact residual (natural map of the dry contact forces, relative to
+    /// the step's force scale; docs/contact-solver.md).
+    pub contact_tol: f64,
+}
+
+/// How the contact conditions are solved in each Newton iteration (docs/contact-solver.md).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ContactSolver {
+    /// The contact law inside the step's Newton loop, its generalised Jacobian in the sparse
+    /// matrix, with augmented-Lagrangian multiplier updates: no Delassus operator.
+    Newton,
+    /// The reduced system on the dense Delassus operator W = H K̄⁻¹ Hᵀ, solved by nonlinear
+    /// Gauss-Seidel over contact points (small problems, cross-checks).
+    #[default]
+    GaussSeidel,
 }
 
 impl Default for TimeSettings {
@@ -156,6 +173,8 @@ impl Default for TimeSettings {
             max_newton: 25,
             lumped_mass: false,
             rayleigh: (0.0, 0.0),
+            contact_solver: ContactSolver::GaussSeidel,
+            contact_tol: 1e-8,
         }
     }
 }

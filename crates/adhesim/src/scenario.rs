@@ -12,8 +12,8 @@ use crate::mesh::generate::{self, FlatSide};
 use crate::mesh::{gmsh, quality};
 use crate::mesh::{Face, Mesh};
 use crate::problem::{
-    Body, Dirichlet, MapRequest, NodalLoad, OutputSettings, Problem, Rotation, Table, TimeSettings,
-    Track,
+    Body, ContactSolver, Dirichlet, MapRequest, NodalLoad, OutputSettings, Problem, Rotation,
+    Table, TimeSettings, Track,
 };
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -79,6 +79,8 @@ struct FileTime {
     mass: Option<String>,
     rayleigh_alpha: Option<f64>,
     rayleigh_beta: Option<f64>,
+    contact_solver: Option<String>,
+    contact_tol: Option<f64>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -790,6 +792,22 @@ fn validate_time(t: &FileTime, ctx: &Ctx) -> Result<TimeSettings, ScenarioError>
             return Err(ctx.err(format!("`{k}` must be ≥ 0, got {v}")));
         }
     }
+    let contact_solver = match t.contact_solver.as_deref() {
+        None => d.contact_solver,
+        Some("newton") => ContactSolver::Newton,
+        Some("gauss-seidel") => ContactSolver::GaussSeidel,
+        Some(m) => {
+            return Err(ctx.err(format!(
+                "`time.contact_solver` = {m:?}; valid values are \"newton\" and \"gauss-seidel\""
+            )))
+        }
+    };
+    let contact_tol = t.contact_tol.unwrap_or(d.contact_tol);
+    if !(contact_tol > 0.0 && contact_tol < 1.0) {
+        return Err(ctx.err(format!(
+            "`time.contact_tol` must be in (0, 1), got {contact_tol}"
+        )));
+    }
     Ok(TimeSettings {
         t_end,
         dt,
@@ -801,6 +819,8 @@ fn validate_time(t: &FileTime, ctx: &Ctx) -> Result<TimeSettings, ScenarioError>
         max_newton,
         lumped_mass,
         rayleigh: (alpha, beta),
+        contact_solver,
+        contact_tol,
     })
 }
 

@@ -10,9 +10,11 @@
 use crate::assembly::{BadElement, Discretisation};
 use crate::contact::detect::{detect, ContactPoint};
 use crate::contact::law::{BondState, ContactState, PointSolution};
+use crate::contact::newton::{self, augmented_point, updated_multiplier, AugmentedPoint};
 use crate::contact::solve::{delassus, gauss_seidel, Delassus};
-use crate::linalg::{LinalgError, SparseCholesky};
-use crate::problem::Problem;
+use crate::linalg::LinalgError;
+use crate::problem::{ContactSolver, Problem};
+use crate::system::SystemMatrix;
 use std::sync::Arc;
 
 /// Why a run could not be set up.
@@ -71,8 +73,12 @@ pub struct StepReport {
     pub internal: f64,
     /// Work done on the bodies since t = 0 by loads, gravity, supports and contact [J].
     pub external_work: f64,
-    /// Gauss-Seidel sweeps over contact points, summed over the Newton iterations.
+    /// Contact iterations, summed over the Newton iterations: Gauss-Seidel sweeps over the
+    /// contact points, or multiplier updates of the Newton contact solve.
     pub contact_sweeps: usize,
+    /// Contact residual of the committed solution: the natural map of the dry contact forces
+    /// relative to the step's force scale (0 without contact points; docs/contact-solver.md).
+    pub contact_residual: f64,
     /// Contact candidates of the step.
     pub contact_points: usize,
     /// Delassus operators built in the step (0 when the last one could be reused).
@@ -88,9 +94,10 @@ pub struct PhaseTimes {
     pub assembly: f64,
     /// Numeric factorisation of K̄ and the free solve.
     pub factorisation: f64,
-    /// Contact detection and the Delassus operator W = H K̄⁻¹ Hᵀ.
+    /// Contact detection, the Delassus operator W = H K̄⁻¹ Hᵀ (Gauss-Seidel solver) or the
+    /// analysis of the contact couplings' pattern (Newton solver).
     pub delassus: f64,
-    /// Gauss-Seidel over contact points.
+    /// Gauss-Seidel over contact points, or the contact law and its tangent (Newton solver).
     pub contact_solve: f64,
 }
 
@@ -169,9 +176,8 @@ pub struct Stepper {
     mass: Vec<f64>,
     damping: Option<Vec<f64>>,
     gravity_force: Vec<f64>,
-    chol: SparseCholesky,
+    system: SystemMatrix,
     constrained: Vec<bool>,
-    zero_positions: Vec<usize>,
     dt: f64,
     good_steps_since_cut: usize,
     f_ext0: Vec<f64>,
@@ -198,6 +204,7 @@ struct Attempt {
     points: Vec<ContactPoint>,
     solutions: Vec<PointSolution>,
     sweeps: usize,
+    contact_residual: f64,
     delassus_builds: usize,
     timings: PhaseTimes,
 }
@@ -237,17 +244,7 @@ impl Stepper {
                 }
             }
         }
-        let p = &disc.pattern;
-        let mut zero_positions = Vec::new();
-        for j in 0..p.dim() {
-            for q in p.col_ptr[j]..p.col_ptr[j + 1] {
-                let i = p.row_idx[q];
-                if i != j && (constrained[i] || constrained[j]) {
-                    zero_positions.push(q);
-                }
-            }
-        }
-        let chol = SparseCholesky::analyse(p, 0)?;
+        let system = SystemMatrix::new(disc.pattern.clone(), constrained.clone())?;
         let mut v0 = vec![0.0; n];
         let offsets = problem.node_offsets();
         for (b, off) in problem.bodies.iter().zip(offsets) {
@@ -269,9 +266,8 @@ impl Stepper {
             mass,
             damping,
             gravity_force,
-            chol,
+            system,
             constrained,
-            zero_positions,
             good_steps_since_cut: 0,
             f_ext0: vec![0.0; n],
             f_int0: vec![0.0; n],
@@ -431,8 +427,8 @@ impl Stepper {
             match self.attempt(dt) {
                 Ok(a) => {
                     self.commit_contact(&a.points, &a.solutions);
-                    let (contact_sweeps, contact_points, timings) =
-                        (a.sweeps, a.points.len(), a.timings);
+                    let (contact_sweeps, contact_points, timings, contact_residual) =
+                        (a.sweeps, a.points.len(), a.timings, a.contact_residual);
                     self.commit(a.u, a.v, dt);
                     self.external_work += a.work;
                     self.last_internal = a.internal;
@@ -463,6 +459,7 @@ impl Stepper {
                         internal: a.internal,
                         external_work: self.external_work,
                         contact_sweeps,
+                        contact_residual,
                         contact_points,
                         delassus_builds: a.delassus_builds,
                         timings,
@@ -547,14 +544,34 @@ impl Stepper {
         self.delassus_cache = None;
     }
 
+    /// Committed dry force of each contact point, in its local frame: the warm start of the
+    /// Newton contact solve's multipliers.
+    fn multipliers_at_start(&self, points: &[ContactPoint]) -> Vec<[f64; 3]> {
+        points
+            .iter()
+            .map(|pt| {
+                let c = &self.contact[pt.pair][pt.local];
+                if c.state == 0 {
+                    return [0.0; 3];
+                }
+                let [t1, t2] = c.tangent_axes;
+                let n = crate::contact::detect::cross(t1, t2);
+                let g: [f64; 3] = std::array::from_fn(|k| {
+                    c.r_dry[0] * t1[k] + c.r_dry[1] * t2[k] + c.r_dry[2] * n[k]
+                });
+                pt.frame
+                    .map(|axis| axis[0] * g[0] + axis[1] * g[1] + axis[2] * g[2])
+            })
+            .collect()
+    }
+
     /// One Newton solve over [t, t+dt]; Err with the reason on failure.
     fn attempt(&mut self, dt: f64) -> Result<Attempt, String> {
-        let ts = &self.problem.time;
+        let ts = self.problem.time.clone();
         let (theta, xi, qs) = (ts.theta, ts.xi, ts.quasi_static);
+        let newton_contact = ts.contact_solver == ContactSolver::Newton;
         let t1 = self.state.t + dt;
         let n = self.disc.num_dofs();
-        let u0 = &self.state.u;
-        let v0 = &self.state.v;
         let f_ext1 = self.external_force(t1);
         let mut timings = PhaseTimes::default();
         let clock = std::time::Instant::now();
@@ -564,7 +581,7 @@ impl Stepper {
             detect(
                 &self.problem.contacts,
                 &self.disc.reference,
-                u0,
+                &self.state.u,
                 self.state.t,
                 t1,
             )
@@ -576,7 +593,20 @@ impl Stepper {
         let mut solutions: Vec<PointSolution> = Vec::new();
         let mut sweeps = 0;
         let mut contact_force = vec![0.0; n];
+        // Newton contact solve: multipliers (warm-started from the committed dry forces),
+        // augmentation parameters (set at the first iteration) and the law at the iterate.
+        let mut lambda = self.multipliers_at_start(&points);
+        let mut rho: Vec<f64> = Vec::new();
+        let mut evals: Vec<AugmentedPoint> = Vec::new();
+        let mut contact_residual = 0.0;
+        if newton_contact && !points.is_empty() {
+            self.system
+                .ensure_couplings(&newton::couplings(&points))
+                .map_err(|e| e.to_string())?;
+        }
         timings.delassus += clock.elapsed().as_secs_f64();
+        let u0 = &self.state.u;
+        let v0 = &self.state.v;
         // Predictor: constant velocity for dynamics, last state for quasi-static.
         let mut u: Vec<f64> = if qs {
             u0.clone()
@@ -609,13 +639,18 @@ impl Stepper {
         let c_stiff = if qs { 1.0 } else { xi };
         let mut g = vec![0.0; n];
         let mut tmp = vec![0.0; n];
-        let mut kbar = vec![0.0; self.disc.pattern.nnz()];
         let mut last_correction_negligible = false;
+        let mut last_rel = f64::NAN;
+        let mut line_search: Option<LineSearch> = None;
         let mut prev_du_norm: Option<f64> = None;
         let mut delassus_builds = 0usize;
         // Whether this attempt has built or checked the Delassus operator in use.
         let mut delassus_checked = false;
-        let delassus_key = delassus_key(&points, dt);
+        let delassus_key = if newton_contact {
+            Vec::new()
+        } else {
+            delassus_key(&points, dt)
+        };
         for iter in 1..=ts.max_newton {
             let clock = std::time::Instant::now();
             let asm = self.disc.assemble(&u, true);
@@ -654,6 +689,52 @@ impl Stepper {
                     }
                 }
             }
+            let mut contact_defect = 0.0;
+            if iter == 1 && !points.is_empty() {
+                rho = self.augmentation(&points, &asm.tangent, c_stiff, c_mass, c_damp);
+            }
+            if newton_contact && !points.is_empty() {
+                let clock = std::time::Instant::now();
+                // The contact law at u with the multipliers of the last Newton step.
+                (evals, contact_force) =
+                    self.contact_law_at(&points, &laws, &bond0, dt, &rho, &lambda, &u);
+                let merit = norm_free(&g, &contact_force, &self.constrained);
+                // Line search on that step: within one set of contact cases (open, stick,
+                // slide at every point) the Newton step must reduce ‖G(u) − Hᵀr(u)‖, else it
+                // is halved. A step that changes the cases is taken whole (an active-set
+                // step), unless the iteration count says the cases are cycling.
+                if let Some(ls) = &mut line_search {
+                    let same_cases = evals
+                        .iter()
+                        .zip(&ls.cases)
+                        .all(|(e, c)| e.solution.state == *c);
+                    if (same_cases || iter > CYCLING_ITERATIONS)
+                        && merit > (1.0 - 1e-4 * ls.alpha) * ls.merit0
+                        && ls.alpha > MIN_STEP_LENGTH
+                    {
+                        ls.alpha *= 0.5;
+                        for i in 0..n {
+                            u[i] = ls.u0[i] + ls.alpha * ls.du[i];
+                        }
+                        timings.contact_solve += clock.elapsed().as_secs_f64();
+                        continue;
+                    }
+                }
+                contact_defect = newton::defect_norm(&evals);
+                // Multiplier update λ ← P_K(λ − ρ x̂(u)) once the equilibrium with the current
+                // multipliers is reached to a tenth of the change the update would make.
+                if iter > 1 && merit <= 0.1 * contact_defect {
+                    for (p, pt) in points.iter().enumerate() {
+                        let x = pt.local_x(&self.disc.reference, &u);
+                        lambda[p] = updated_multiplier(laws[pt.pair].mu, rho[p], lambda[p], x);
+                    }
+                    sweeps += 1;
+                    (evals, contact_force) =
+                        self.contact_law_at(&points, &laws, &bond0, dt, &rho, &lambda, &u);
+                    contact_defect = newton::defect_norm(&evals);
+                }
+                timings.contact_solve += clock.elapsed().as_secs_f64();
+            }
             // g is G(u) without contact (what the Newton correction solves against); the
             // convergence check uses G(u) − Hᵀr.
             let mut g_check: Vec<f64> = (0..n).map(|i| g[i] - contact_force[i]).collect();
@@ -676,14 +757,27 @@ impl Stepper {
             // Force scale of the current iterate (internal, external, inertial forces and
             // support reactions), so that a large out-of-balance force of an early iterate
             // does not make later residuals look small.
-            let scale = scale.max(norm(&reactions));
-            let rel = gnorm / scale.max(f64::MIN_POSITIVE);
+            let scale = scale.max(norm(&reactions)).max(f64::MIN_POSITIVE);
+            let rel = gnorm / scale;
+            last_rel = rel;
+            if std::env::var_os("ADHESIM_DEBUG").is_some() {
+                let states: Vec<i32> = evals
+                    .iter()
+                    .map(|e| e.solution.state as i32 * 10 + (e.solution.beta > 0.0) as i32)
+                    .collect();
+                eprintln!("t={:.9} dt={dt:.3e} iter={iter} rel={rel:.3e} contact={:.3e} upd={sweeps} {:?}", self.state.t, contact_defect/scale, states);
+            }
+            if newton_contact {
+                contact_residual = contact_defect / scale;
+            }
             // Converged when the residual is small against the forces, or when the last
             // correction was negligible against the step's displacement increment (the
             // residual can sit at its round-off floor when every force is small, e.g. a
-            // vibrating body passing through its rest position).
-            // With contact candidates, the contact problem must have been solved at least once.
-            let contact_solved = points.is_empty() || iter > 1;
+            // vibrating body passing through its rest position), and the contact forces
+            // satisfy the contact law. With contact candidates, the contact problem must have
+            // been solved at least once.
+            let contact_solved =
+                points.is_empty() || (iter > 1 && contact_residual <= ts.contact_tol);
             if contact_solved
                 && (rel <= ts.newton_tol || gnorm == 0.0 || last_correction_negligible)
             {
@@ -696,6 +790,9 @@ impl Stepper {
                         (1.0 - xi) * self.f_ext0[i] + xi * f_ext1[i]
                     };
                     work += du[i] * (f_applied + reactions[i] + contact_force[i]);
+                }
+                if newton_contact {
+                    solutions = evals.iter().map(|e| e.solution).collect();
                 }
                 return Ok(Attempt {
                     v: if qs {
@@ -713,6 +810,7 @@ impl Stepper {
                     points,
                     solutions,
                     sweeps,
+                    contact_residual,
                     delassus_builds,
                     timings,
                 });
@@ -721,37 +819,28 @@ impl Stepper {
                 break;
             }
             let clock = std::time::Instant::now();
-            // K̄ = c_stiff K + c_damp A + c_mass M.
-            for (q, k) in kbar.iter_mut().enumerate() {
-                *k = c_stiff * asm.tangent[q] + c_mass * self.mass[q];
-            }
+            // K̄ = c_stiff K + c_damp A + c_mass M (+ the contact law's stiffness).
+            let mut terms: Vec<(f64, &[f64])> = vec![(c_stiff, &asm.tangent), (c_mass, &self.mass)];
             if let Some(a) = &self.damping {
-                for (k, av) in kbar.iter_mut().zip(a) {
-                    *k += c_damp * av;
-                }
+                terms.push((c_damp, a));
             }
-            for &q in &self.zero_positions {
-                kbar[q] = 0.0;
+            self.system.set_from_base(&terms);
+            if newton_contact && !points.is_empty() {
+                let stiffness: Vec<_> = evals.iter().map(|e| e.stiffness).collect();
+                let pattern = self.system.pattern().clone();
+                newton::add_contact_tangent(&points, &stiffness, &pattern, &mut self.system.values);
             }
-            for d in 0..n {
-                if self.constrained[d] {
-                    let q = self.disc.pattern.diagonal_position(d);
-                    if !(kbar[q] > 0.0) {
-                        kbar[q] = 1.0;
-                    }
-                }
-            }
-            self.chol
-                .factorise(&kbar)
+            self.system
+                .factorise()
                 .map_err(|e| format!("{e} (Newton iteration {iter})"))?;
-            // Newton correction against the residual with the current contact forces
-            // Hᵀr_prev; the contact solve then corrects it by K̄⁻¹Hᵀ(r − r_prev). At a converged
-            // iterate r = r_prev and G(u) = Hᵀr whatever W was used, so W may be reused from
-            // an earlier iteration or step (it then only slows the convergence).
+            // Newton correction against the residual with the current contact forces Hᵀr.
+            // Gauss-Seidel: the contact solve then corrects it by K̄⁻¹Hᵀ(r − r_prev). At a
+            // converged iterate r = r_prev and G(u) = Hᵀr whatever W was used, so W may be
+            // reused from an earlier iteration or step (it then only slows the convergence).
             let mut du: Vec<f64> = (0..n).map(|i| contact_force[i] - g[i]).collect();
-            self.chol.solve_in_place(&mut du);
+            self.system.solve_in_place(&mut du);
             timings.factorisation += clock.elapsed().as_secs_f64();
-            if !points.is_empty() {
+            if !newton_contact && !points.is_empty() {
                 let clock = std::time::Instant::now();
                 let du_norm = norm(&du);
                 let slow = prev_du_norm.is_some_and(|p| du_norm > DELASSUS_REUSE_RATIO * p);
@@ -772,12 +861,15 @@ impl Stepper {
                         .map(|(p, _)| p)
                         .unwrap_or(0);
                     let cached = &self.delassus_cache.as_ref().expect("checked").1;
-                    reusable =
-                        cached.probed_change(&points, probe, &mut self.chol, &self.constrained)
-                            <= DELASSUS_STALE_TOL;
+                    reusable = cached.probed_change(
+                        &points,
+                        probe,
+                        self.system.cholesky(),
+                        &self.constrained,
+                    ) <= DELASSUS_STALE_TOL;
                 }
                 if !reusable {
-                    let del = delassus(&points, &mut self.chol, &self.constrained);
+                    let del = delassus(&points, self.system.cholesky(), &self.constrained);
                     self.delassus_cache = Some((delassus_key.clone(), del));
                     delassus_builds += 1;
                     delassus_checked = true;
@@ -828,13 +920,23 @@ impl Stepper {
                     }
                 }
                 let mut dc: Vec<f64> = (0..n).map(|i| new_force[i] - contact_force[i]).collect();
-                self.chol.solve_in_place(&mut dc);
+                self.system.solve_in_place(&mut dc);
                 for i in 0..n {
                     du[i] += dc[i];
                 }
                 contact_force = new_force;
                 solutions = sol.points;
+                contact_residual = gauss_seidel_residual(&laws, &points, &rho, &solutions) / scale;
                 timings.delassus += clock.elapsed().as_secs_f64();
+            }
+            if newton_contact && !points.is_empty() {
+                line_search = Some(LineSearch {
+                    cases: evals.iter().map(|e| e.solution.state).collect(),
+                    u0: u.clone(),
+                    du: du.clone(),
+                    alpha: 1.0,
+                    merit0: gnorm,
+                });
             }
             for i in 0..n {
                 u[i] += du[i];
@@ -846,10 +948,117 @@ impl Stepper {
         }
         self.delassus_cache = None;
         Err(format!(
-            "Newton did not converge in {} iterations",
-            ts.max_newton
+            "Newton did not converge in {} iterations (residual {:.2e}, contact residual {:.2e})",
+            ts.max_newton, last_rel, contact_residual
         ))
     }
+
+    /// The contact law of every point at displacement `u` with multipliers `lambda`, and the
+    /// contact force Hᵀr on the free unknowns.
+    #[allow(clippy::too_many_arguments)]
+    fn contact_law_at(
+        &self,
+        points: &[ContactPoint],
+        laws: &[crate::contact::InterfaceLaw],
+        bond0: &[BondState],
+        dt: f64,
+        rho: &[f64],
+        lambda: &[[f64; 3]],
+        u: &[f64],
+    ) -> (Vec<AugmentedPoint>, Vec<f64>) {
+        let evals: Vec<AugmentedPoint> = points
+            .iter()
+            .enumerate()
+            .map(|(p, pt)| {
+                let x = pt.local_x(&self.disc.reference, u);
+                augmented_point(&laws[pt.pair], bond0[p], dt, pt.area, rho[p], lambda[p], x)
+            })
+            .collect();
+        let mut force = vec![0.0; u.len()];
+        for (pt, ev) in points.iter().zip(&evals) {
+            pt.add_ht(ev.solution.r(), &mut force);
+        }
+        for (f, &fixed) in force.iter_mut().zip(&self.constrained) {
+            if fixed {
+                *f = 0.0;
+            }
+        }
+        (evals, force)
+    }
+
+    /// Augmentation parameter ρ_α [N/m] of each point: [`newton::RHO_FACTOR`] times the
+    /// stiffness K̄ = c_stiff K + c_mass M + c_damp A shows there.
+    fn augmentation(
+        &self,
+        points: &[ContactPoint],
+        tangent: &[f64],
+        c_stiff: f64,
+        c_mass: f64,
+        c_damp: f64,
+    ) -> Vec<f64> {
+        let pattern = &self.disc.pattern;
+        let diagonal: Vec<f64> = (0..pattern.dim())
+            .map(|d| {
+                let q = pattern.diagonal_position(d);
+                let a = self.damping.as_ref().map_or(0.0, |a| a[q]);
+                c_stiff * tangent[q] + c_mass * self.mass[q] + c_damp * a
+            })
+            .collect();
+        points
+            .iter()
+            .map(|pt| {
+                newton::point_stiffness(pt, &diagonal, &self.constrained)
+                    .map_or(1.0, |k| newton::RHO_FACTOR * k)
+            })
+            .collect()
+    }
+}
+
+/// Natural-map residual ‖(r̄_α − P_K(r̄_α − ρ_α x̂_α))_α‖ [N] of a Gauss-Seidel solution at its
+/// own x, with the ρ_α of the Newton solver, so that both solvers report the same measure.
+fn gauss_seidel_residual(
+    laws: &[crate::contact::InterfaceLaw],
+    points: &[ContactPoint],
+    rho: &[f64],
+    solutions: &[PointSolution],
+) -> f64 {
+    points
+        .iter()
+        .zip(rho)
+        .zip(solutions)
+        .map(|((pt, &rho), sol)| {
+            let p = updated_multiplier(laws[pt.pair].mu, rho, sol.r_dry, sol.x);
+            (0..3).map(|k| (sol.r_dry[k] - p[k]).powi(2)).sum::<f64>()
+        })
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// A Newton step under line search: from `u0` along `du`, at step length `alpha`, against the
+/// residual norm `merit0` at `u0`.
+struct LineSearch {
+    cases: Vec<ContactState>,
+    u0: Vec<f64>,
+    du: Vec<f64>,
+    alpha: f64,
+    merit0: f64,
+}
+
+/// Newton iterations after which a step that changes the contact cases is line-searched too.
+const CYCLING_ITERATIONS: usize = 8;
+
+/// Shortest step length the line search tries before it takes the step anyway.
+const MIN_STEP_LENGTH: f64 = 1.0 / 64.0;
+
+/// ‖g − f‖ over the free unknowns.
+fn norm_free(g: &[f64], f: &[f64], constrained: &[bool]) -> f64 {
+    g.iter()
+        .zip(f)
+        .zip(constrained)
+        .filter(|(_, &c)| !c)
+        .map(|((a, b), _)| (a - b) * (a - b))
+        .sum::<f64>()
+        .sqrt()
 }
 
 /// A Newton correction larger than this fraction of the previous one means the contact

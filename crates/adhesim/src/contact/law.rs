@@ -736,20 +736,25 @@ fn beta_step(beta0: f64, dt: f64, p: &RccParams, e: f64) -> (f64, f64) {
 /// φ = A [½ E β₁² − w β₁ + b/(2Δt) (β₁ − β₀)²] (β₁ minimises the bracket over [0, 1], so
 /// ∂φ/∂x = A β₁² ∂E/∂x / 2 = −r̃).
 fn adhesion_eval(p: &PointProblem, a: &RccParams, x: V3) -> AdhEval {
-    let ut = [p.bond0.ut[0] + x[0], p.bond0.ut[1] + x[1]];
+    adhesion_at(p.bond0, p.dt, p.area, a, x)
+}
+
+/// [`adhesion_eval`] from the committed bond state, Δt [s] and tributary area [m²].
+fn adhesion_at(bond0: BondState, dt: f64, area: f64, a: &RccParams, x: V3) -> AdhEval {
+    let ut = [bond0.ut[0] + x[0], bond0.ut[1] + x[1]];
     let e = stretch_energy(a, x[2], ut);
-    let (beta, c) = beta_step(p.bond0.beta, p.dt, a, e);
-    let force = adhesive_force(beta, a, x[2], ut, p.area);
+    let (beta, c) = beta_step(bond0.beta, dt, a, e);
+    let force = adhesive_force(beta, a, x[2], ut, area);
     let xp = x[2].max(0.0);
     let mut energy = 0.5 * e * beta * beta - a.w.max(0.0) * beta;
-    if a.b > 0.0 && p.dt > 0.0 {
-        let d = beta - clamp01(p.bond0.beta);
-        energy += 0.5 * a.b / p.dt * d * d;
+    if a.b > 0.0 && dt > 0.0 {
+        let d = beta - clamp01(bond0.beta);
+        energy += 0.5 * a.b / dt * d * d;
     }
-    energy *= p.area;
+    energy *= area;
     let mut stiff = [[0.0; 3]; 3];
     if beta > 0.0 {
-        let k = p.area * beta * beta;
+        let k = area * beta * beta;
         let v = [a.ct * ut[0], a.ct * ut[1], a.cn * xp];
         let dn = if x[2] > 0.0 { a.cn } else { 0.0 };
         let diag = [a.ct, a.ct, dn];
@@ -766,6 +771,46 @@ fn adhesion_eval(p: &PointProblem, a: &RccParams, x: V3) -> AdhEval {
         force,
         stiff,
         energy,
+    }
+}
+
+/// The RCC adhesive response at a local relative displacement x [m] (model.md §5), for a
+/// point whose committed bond state is `bond0`, over a step of `dt` [s], with tributary area
+/// `area` [m²].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AdhesiveResponse {
+    /// β₁ at the end of the step [-].
+    pub beta: f64,
+    /// Bond stretch to commit [m]: u_t0 + x_t while bonded (β₁ > 0), else 0.
+    pub ut: [f64; 2],
+    /// Adhesive force r̃ [N] in the local frame.
+    pub force: [f64; 3],
+    /// −∂r̃/∂x with β₁ held fixed [N/m]: A β₁² diag(C_t, C_t, C_n [x_n > 0]), symmetric
+    /// positive semi-definite (the softening part from ∂β₁/∂x is left out).
+    pub secant_stiffness: [[f64; 3]; 3],
+}
+
+/// [`AdhesiveResponse`] of the law `a` at `x` [m].
+pub fn adhesive_response(
+    a: &RccParams,
+    bond0: BondState,
+    dt: f64,
+    area: f64,
+    x: [f64; 3],
+) -> AdhesiveResponse {
+    let ev = adhesion_at(bond0, dt, area, a, x);
+    let k = area * ev.beta * ev.beta;
+    let mut secant_stiffness = [[0.0; 3]; 3];
+    if ev.beta > 0.0 {
+        secant_stiffness[0][0] = k * a.ct;
+        secant_stiffness[1][1] = k * a.ct;
+        secant_stiffness[2][2] = if x[2] > 0.0 { k * a.cn } else { 0.0 };
+    }
+    AdhesiveResponse {
+        beta: ev.beta,
+        ut: if ev.beta > 0.0 { ev.ut } else { [0.0; 2] },
+        force: ev.force,
+        secant_stiffness,
     }
 }
 
@@ -931,16 +976,9 @@ fn newton_step(ctx: &Ctx, ev: &Eval) -> Option<V3> {
     solve3(jac, neg(ev.f)).filter(|d| d.iter().all(|v| v.is_finite()))
 }
 
-/// Generalised Jacobian ∂P_K/∂r* of [`dry_projection`] at `r_star` [-], for the case that
-/// [`dry_projection`] returned there: 0 apart, I sticking, the derivative of the sliding
-/// formula otherwise (at the cone's apex, ‖r*_t‖ = 0, the element (0, 0, 1/(1 + μ²)) on the
-/// diagonal is used).
-pub fn dry_projection_jacobian(r_star: [f64; 3], mu: f64, case: ContactState) -> [[f64; 3]; 3] {
-    projection_jacobian(r_star, mu.max(0.0), case)
-}
-
-/// Jacobian of [`dry_projection`] at `r_star` in the given case.
-fn projection_jacobian(r_star: V3, mu: f64, case: ContactState) -> M3 {
+/// Jacobian of [`dry_projection`] at `r_star` in the given case (symmetric, eigenvalues in
+/// [0, 1]).
+pub fn projection_jacobian(r_star: V3, mu: f64, case: ContactState) -> M3 {
     match case {
         ContactState::Apart => [[0.0; 3]; 3],
         ContactState::Stick => identity(),

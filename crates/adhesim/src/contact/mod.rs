@@ -9,6 +9,7 @@
 pub mod detect;
 pub mod law;
 pub mod natural_map;
+pub mod newton;
 pub mod reduced;
 pub mod semismooth;
 pub mod solve;

@@ -9,7 +9,7 @@
 //!
 //! ∂F_α/∂r_β = δ_αβ (I − P'_α) + ρ_α P'_α D_α W_αβ,
 //!
-//! where P'_α = [`dry_projection_jacobian`] at the trial force and D_α = ∂(x + μ‖x_t‖n)/∂x
+//! where P'_α = [`projection_jacobian`] at the trial force and D_α = ∂(x + μ‖x_t‖n)/∂x
 //! = I + μ n (x_t/‖x_t‖, 0)ᵀ (the second term dropped at ‖x_t‖ = 0). The Newton system has the
 //! sparsity of W in 3×3 blocks and is solved by a sparse LU factorisation.
 //!
@@ -31,7 +31,7 @@
 use faer::linalg::solvers::Solve;
 use faer::sparse::{SparseColMat, Triplet};
 
-use super::law::{bipotential_trial, dry_projection, dry_projection_jacobian};
+use super::law::{bipotential_trial, dry_projection, projection_jacobian};
 use super::natural_map::{natural_map_residual, relative_error};
 use super::reduced::{gauss_seidel_sweep, point_rhos, BlockSparseDelassus, ReducedSolution};
 
@@ -97,7 +97,7 @@ fn newton_direction(
         let mu_p = mu[p].max(0.0);
         let r_star = bipotential_trial(r[p], x[p], mu_p, rho[p]);
         let (_, case) = dry_projection(r_star, mu_p);
-        let jp = dry_projection_jacobian(r_star, mu_p, case);
+        let jp = projection_jacobian(r_star, mu_p, case);
         // D = I + μ n (x_t/‖x_t‖, 0)ᵀ.
         let mut d: M3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
         let st = x[p][0].hypot(x[p][1]);

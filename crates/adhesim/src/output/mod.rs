@@ -332,6 +332,7 @@ pub fn history_columns(problem: &Problem) -> Vec<String> {
     c.push("contact_sweeps".into());
     c.push("contact_points".into());
     c.push("delassus_builds".into());
+    c.push("contact_residual".into());
     for f in [
         "time_assembly",
         "time_factorisation",
@@ -444,6 +445,7 @@ impl Observer for HistoryObserver {
         row.push(r.contact_sweeps as f64);
         row.push(r.contact_points as f64);
         row.push(r.delassus_builds as f64);
+        row.push(r.contact_residual);
         let tm = &r.timings;
         row.extend_from_slice(&[tm.assembly, tm.factorisation, tm.delassus, tm.contact_solve]);
         for nodes in view.contact {
