@@ -4,7 +4,9 @@
 //! Usage: fclib-bench [--tol T] [--runs N] [--max-iter N] [--solvers a,b,...] FILE...
 //!
 //! Solvers: `nsgs-dense` (the stepper's Gauss-Seidel on a dense W, `contact::solve`),
-//! `nsgs-blocks` (Gauss-Seidel on W in 3×3 sparse blocks), `newton` (semismooth Newton).
+//! `nsgs-blocks` (Gauss-Seidel on W in 3×3 sparse blocks), `newton` (semismooth Newton),
+//! `newton-prox` (proximal-point iterations of semismooth Newton). Newton solvers stop after
+//! at most 2000 iterations whatever `--max-iter` says.
 //! Global problems are condensed to W = Hᵀ M⁻¹ H first; the condensation is timed apart and not
 //! included in the solvers' times. Every solver starts from r = 0.
 //! Output: one CSV line per file and solver.
@@ -15,14 +17,16 @@ use std::time::Instant;
 use adhesim::contact::detect::ContactPoint;
 use adhesim::contact::law::{BondState, InterfaceLaw};
 use adhesim::contact::reduced::{error_of, gauss_seidel_blocks, ReducedSolution};
-use adhesim::contact::semismooth::semismooth_newton;
+use adhesim::contact::semismooth::{proximal_newton, semismooth_newton};
 use adhesim::contact::solve::{gauss_seidel, Delassus};
 use adhesim_fclib::{read, Problem, ReducedProblem};
 
-const SOLVERS: [&str; 3] = ["nsgs-dense", "nsgs-blocks", "newton"];
+const SOLVERS: [&str; 4] = ["nsgs-dense", "nsgs-blocks", "newton", "newton-prox"];
 /// Default largest number of iterations (Gauss-Seidel sweeps; Newton steps plus fallback
 /// sweeps).
 const MAX_ITER: usize = 100_000;
+/// Largest number of iterations of the Newton solvers (each costs a sparse factorisation).
+const MAX_NEWTON: usize = 2_000;
 /// No further repetition once one run took this long [s].
 const LONG_RUN: f64 = 5.0;
 
@@ -142,7 +146,10 @@ fn solve(name: &str, p: &ReducedProblem, del: &Delassus, o: &Options) -> Reduced
     match name {
         "nsgs-dense" => nsgs_dense(p, del, o.tol, o.max_iter),
         "nsgs-blocks" => gauss_seidel_blocks(&p.w, &p.q, &p.mu, &r0, o.tol, o.max_iter),
-        "newton" => semismooth_newton(&p.w, &p.q, &p.mu, &r0, o.tol, o.max_iter).0,
+        "newton" => semismooth_newton(&p.w, &p.q, &p.mu, &r0, o.tol, o.max_iter.min(MAX_NEWTON)).0,
+        "newton-prox" => {
+            proximal_newton(&p.w, &p.q, &p.mu, &r0, o.tol, o.max_iter.min(MAX_NEWTON)).0
+        }
         _ => unreachable!("solver names are checked when parsing"),
     }
 }

@@ -124,6 +124,17 @@ impl BlockSparseDelassus {
             .zip(&self.blocks[range])
     }
 
+    /// W + η I [m/N].
+    pub fn with_diagonal_shift(&self, eta: f64) -> Self {
+        let mut shifted = self.clone();
+        for &k in &shifted.diag {
+            for a in 0..3 {
+                shifted.blocks[k][a][a] += eta;
+            }
+        }
+        shifted
+    }
+
     /// x = q + W r.
     pub fn apply(&self, r: &[[f64; 3]], q: &[[f64; 3]], x: &mut [[f64; 3]]) {
         for p in 0..self.points {
