@@ -8,7 +8,10 @@
 
 pub mod detect;
 pub mod law;
+pub mod natural_map;
 pub mod newton;
+pub mod reduced;
+pub mod semismooth;
 pub mod solve;
 
 pub use detect::{ContactPair, Master, RigidMotion, RigidShape};

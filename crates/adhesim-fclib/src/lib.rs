@@ -1,0 +1,505 @@
+//! fclib frictional contact problems for adhesim's contact solvers.
+//!
+//! fclib (the format of the Siconos project's contact test data) stores discrete 3D frictional
+//! contact problems in HDF5:
+//! - local: u = W r + q, r ∈ K_μ, û = u + μ‖u_T‖N ∈ K*_μ (group `/fclib_local`);
+//! - global: M v = H r + f, u = Hᵀ v + w, same cone conditions (group `/fclib_global`);
+//! - optionally a stored solution (`/solution`) and initial guesses (`/guesses`).
+//!
+//! Contact components there are ordered (N, T1, T2), the normal first; adhesim orders them
+//! (t1, t2, n). Both take r_N ≥ 0 as compression and u_N ≥ 0 as separation, so converting is a
+//! permutation of the components of every contact ([`to_adhesim`], [`from_adhesim`]), done at
+//! the boundary by [`ReducedProblem::from_local`] and [`ReducedProblem::condense`].
+//!
+//! [`read`] needs the HDF5 C library; this crate is kept out of the main library and command
+//! for that reason.
+
+use std::path::{Path, PathBuf};
+
+use adhesim::contact::reduced::BlockSparseDelassus;
+use nalgebra::{DMatrix, DVector};
+
+/// A failure to read an fclib file: the file, the dataset and what went wrong.
+#[derive(Debug, thiserror::Error)]
+pub enum FclibError {
+    /// The HDF5 library failed on a dataset or group.
+    #[error("{file}: {what}: {source}")]
+    Hdf5 {
+        file: PathBuf,
+        what: String,
+        source: hdf5_metno::Error,
+    },
+    /// The content is not a valid fclib problem.
+    #[error("{file}: {what}")]
+    Invalid { file: PathBuf, what: String },
+}
+
+/// How a sparse matrix was stored in the file (fclib's `nz` field).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Storage {
+    /// `nz = -1`: compressed columns (`p` has n + 1 column starts, `i` the row indices).
+    CompressedColumns,
+    /// `nz = -2`: compressed rows (`p` has m + 1 row starts, `i` the column indices).
+    CompressedRows,
+    /// `nz ≥ 0`: `nz` triplets (`i` rows, `p` columns), repeated entries summed.
+    Triplets,
+}
+
+/// A sparse matrix read from a file, as (row, column, value) entries.
+#[derive(Clone, Debug)]
+pub struct SparseMatrix {
+    pub rows: usize,
+    pub cols: usize,
+    /// The storage kind found in the file.
+    pub storage: Storage,
+    /// Entries in file order; repeated (row, column) pairs are to be summed.
+    pub entries: Vec<(usize, usize, f64)>,
+}
+
+impl SparseMatrix {
+    /// Number of stored entries.
+    pub fn nnz(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// The matrix as a dense nalgebra matrix (repeated entries summed).
+    pub fn to_dense(&self) -> DMatrix<f64> {
+        let mut a = DMatrix::zeros(self.rows, self.cols);
+        for &(i, j, v) in &self.entries {
+            a[(i, j)] += v;
+        }
+        a
+    }
+
+    /// Whether every entry lies on the diagonal.
+    pub fn is_diagonal(&self) -> bool {
+        self.entries.iter().all(|&(i, j, _)| i == j)
+    }
+}
+
+/// A local problem u = W r + q in fclib's (N, T1, T2) order.
+#[derive(Clone, Debug)]
+pub struct LocalProblem {
+    pub w: SparseMatrix,
+    pub q: Vec<f64>,
+    pub mu: Vec<f64>,
+}
+
+/// A global problem M v = H r + f, u = Hᵀ v + w in fclib's (N, T1, T2) order.
+#[derive(Clone, Debug)]
+pub struct GlobalProblem {
+    pub m: SparseMatrix,
+    pub h: SparseMatrix,
+    pub f: Vec<f64>,
+    pub w: Vec<f64>,
+    pub mu: Vec<f64>,
+}
+
+/// Either kind of problem.
+#[derive(Clone, Debug)]
+pub enum Problem {
+    Local(LocalProblem),
+    Global(GlobalProblem),
+}
+
+/// A solution or an initial guess, in fclib's order (`v` for global problems only).
+#[derive(Clone, Debug, Default)]
+pub struct Guess {
+    pub r: Vec<f64>,
+    pub u: Vec<f64>,
+    pub v: Option<Vec<f64>>,
+}
+
+/// Everything read from one fclib file.
+#[derive(Clone, Debug)]
+pub struct FclibFile {
+    pub path: PathBuf,
+    pub problem: Problem,
+    /// `/info/title` of the problem group, when present and readable.
+    pub title: Option<String>,
+    /// `/solution`, when present.
+    pub solution: Option<Guess>,
+    /// `/guesses/1..=number_of_guesses`.
+    pub guesses: Vec<Guess>,
+}
+
+impl FclibFile {
+    /// Number of contacts.
+    pub fn contacts(&self) -> usize {
+        match &self.problem {
+            Problem::Local(p) => p.mu.len(),
+            Problem::Global(p) => p.mu.len(),
+        }
+    }
+}
+
+struct Reader<'a> {
+    path: &'a Path,
+    file: hdf5_metno::File,
+}
+
+impl Reader<'_> {
+    fn err(&self, what: impl Into<String>, source: hdf5_metno::Error) -> FclibError {
+        FclibError::Hdf5 {
+            file: self.path.to_path_buf(),
+            what: what.into(),
+            source,
+        }
+    }
+
+    fn invalid(&self, what: impl Into<String>) -> FclibError {
+        FclibError::Invalid {
+            file: self.path.to_path_buf(),
+            what: what.into(),
+        }
+    }
+
+    fn exists(&self, name: &str) -> bool {
+        self.file.link_exists(name)
+    }
+
+    fn f64s(&self, name: &str) -> Result<Vec<f64>, FclibError> {
+        self.file
+            .dataset(name)
+            .and_then(|d| d.read_raw::<f64>())
+            .map_err(|e| self.err(format!("dataset {name}"), e))
+    }
+
+    fn i64s(&self, name: &str) -> Result<Vec<i64>, FclibError> {
+        self.file
+            .dataset(name)
+            .and_then(|d| d.read_raw::<i64>())
+            .map_err(|e| self.err(format!("dataset {name}"), e))
+    }
+
+    fn int(&self, name: &str) -> Result<i64, FclibError> {
+        let v = self.i64s(name)?;
+        match v.as_slice() {
+            [x] => Ok(*x),
+            _ => Err(self.invalid(format!(
+                "dataset {name} holds {} values; one integer expected",
+                v.len()
+            ))),
+        }
+    }
+
+    fn index(&self, name: &str, v: i64, bound: usize) -> Result<usize, FclibError> {
+        usize::try_from(v)
+            .ok()
+            .filter(|&k| k < bound)
+            .ok_or_else(|| self.invalid(format!("{name}: index {v} outside 0..{bound}")))
+    }
+
+    fn sparse(&self, group: &str) -> Result<SparseMatrix, FclibError> {
+        let dim = |key: &str| -> Result<usize, FclibError> {
+            let v = self.int(&format!("{group}/{key}"))?;
+            usize::try_from(v)
+                .map_err(|_| self.invalid(format!("{group}/{key} = {v}; a size ≥ 0 expected")))
+        };
+        let (rows, cols) = (dim("m")?, dim("n")?);
+        let nz = self.int(&format!("{group}/nz"))?;
+        let p = self.i64s(&format!("{group}/p"))?;
+        let i = self.i64s(&format!("{group}/i"))?;
+        let x = self.f64s(&format!("{group}/x"))?;
+        let mut entries = Vec::new();
+        let storage = match nz {
+            -1 | -2 => {
+                let (outer, inner, storage) = if nz == -1 {
+                    (cols, rows, Storage::CompressedColumns)
+                } else {
+                    (rows, cols, Storage::CompressedRows)
+                };
+                if p.len() < outer + 1 {
+                    return Err(self.invalid(format!(
+                        "{group}/p has {} entries; {} expected for compressed storage",
+                        p.len(),
+                        outer + 1
+                    )));
+                }
+                let total = p[outer];
+                if total < 0 || total as usize > i.len().min(x.len()) {
+                    return Err(self.invalid(format!(
+                        "{group}: {total} entries announced, i has {}, x has {}",
+                        i.len(),
+                        x.len()
+                    )));
+                }
+                for k in 0..outer {
+                    let (a, b) = (p[k], p[k + 1]);
+                    if a < 0 || b < a || b > total {
+                        return Err(self.invalid(format!("{group}/p is not increasing at {k}")));
+                    }
+                    for e in a as usize..b as usize {
+                        let other = self.index(&format!("{group}/i"), i[e], inner)?;
+                        let (r, c) = if nz == -1 { (other, k) } else { (k, other) };
+                        entries.push((r, c, x[e]));
+                    }
+                }
+                storage
+            }
+            nz if nz >= 0 => {
+                let nz = nz as usize;
+                if p.len() < nz || i.len() < nz || x.len() < nz {
+                    return Err(self.invalid(format!(
+                        "{group}: nz = {nz} triplets, but p, i, x have {}, {}, {} values",
+                        p.len(),
+                        i.len(),
+                        x.len()
+                    )));
+                }
+                for e in 0..nz {
+                    let r = self.index(&format!("{group}/i"), i[e], rows)?;
+                    let c = self.index(&format!("{group}/p"), p[e], cols)?;
+                    entries.push((r, c, x[e]));
+                }
+                Storage::Triplets
+            }
+            other => {
+                return Err(self.invalid(format!(
+                    "{group}/nz = {other}; -1 (columns), -2 (rows) or a triplet count expected"
+                )))
+            }
+        };
+        Ok(SparseMatrix {
+            rows,
+            cols,
+            storage,
+            entries,
+        })
+    }
+
+    fn guess(&self, group: &str) -> Result<Guess, FclibError> {
+        let v_name = format!("{group}/v");
+        Ok(Guess {
+            r: self.f64s(&format!("{group}/r"))?,
+            u: self.f64s(&format!("{group}/u"))?,
+            v: if self.exists(&v_name) {
+                Some(self.f64s(&v_name)?)
+            } else {
+                None
+            },
+        })
+    }
+
+    fn title(&self, group: &str) -> Option<String> {
+        let ds = self.file.dataset(&format!("{group}/info/title")).ok()?;
+        let s = ds
+            .read_scalar::<hdf5_metno::types::FixedAscii<1024>>()
+            .ok()?;
+        Some(s.as_str().trim_end_matches('\0').to_string())
+    }
+
+    fn check_len(&self, name: &str, v: &[f64], len: usize) -> Result<(), FclibError> {
+        if v.len() == len {
+            Ok(())
+        } else {
+            Err(self.invalid(format!("{name} has {} values; {len} expected", v.len())))
+        }
+    }
+}
+
+/// Reads an fclib file: the local or global problem, its title, the stored solution and the
+/// guesses. Sizes are checked against each other (3 components per contact).
+pub fn read(path: impl AsRef<Path>) -> Result<FclibFile, FclibError> {
+    let path = path.as_ref();
+    let file = hdf5_metno::File::open(path).map_err(|e| FclibError::Hdf5 {
+        file: path.to_path_buf(),
+        what: "opening the file".into(),
+        source: e,
+    })?;
+    let rd = Reader { path, file };
+    let (problem, group) = if rd.exists("fclib_local") {
+        let g = "fclib_local";
+        let w = rd.sparse(&format!("{g}/W"))?;
+        let q = rd.f64s(&format!("{g}/vectors/q"))?;
+        let mu = rd.f64s(&format!("{g}/vectors/mu"))?;
+        let m = 3 * mu.len();
+        if w.rows != m || w.cols != m {
+            return Err(rd.invalid(format!(
+                "W is {}×{}; {m}×{m} expected for {} contacts",
+                w.rows,
+                w.cols,
+                mu.len()
+            )));
+        }
+        rd.check_len("fclib_local/vectors/q", &q, m)?;
+        (Problem::Local(LocalProblem { w, q, mu }), g)
+    } else if rd.exists("fclib_global") {
+        let g = "fclib_global";
+        let m = rd.sparse(&format!("{g}/M"))?;
+        let h = rd.sparse(&format!("{g}/H"))?;
+        let f = rd.f64s(&format!("{g}/vectors/f"))?;
+        let w = rd.f64s(&format!("{g}/vectors/w"))?;
+        let mu = rd.f64s(&format!("{g}/vectors/mu"))?;
+        let nc3 = 3 * mu.len();
+        if m.rows != m.cols || h.rows != m.rows || h.cols != nc3 {
+            return Err(rd.invalid(format!(
+                "M is {}×{} and H {}×{}; M square and H {}×{nc3} expected",
+                m.rows, m.cols, h.rows, h.cols, m.rows
+            )));
+        }
+        rd.check_len("fclib_global/vectors/f", &f, m.rows)?;
+        rd.check_len("fclib_global/vectors/w", &w, nc3)?;
+        (Problem::Global(GlobalProblem { m, h, f, w, mu }), g)
+    } else {
+        return Err(rd.invalid("neither /fclib_local nor /fclib_global is present"));
+    };
+    let solution = if rd.exists("solution") {
+        Some(rd.guess("solution")?)
+    } else {
+        None
+    };
+    let mut guesses = Vec::new();
+    if rd.exists("guesses") {
+        let count = rd.int("guesses/number_of_guesses")?;
+        for k in 1..=count.max(0) {
+            guesses.push(rd.guess(&format!("guesses/{k}"))?);
+        }
+    }
+    Ok(FclibFile {
+        path: path.to_path_buf(),
+        title: rd.title(group),
+        problem,
+        solution,
+        guesses,
+    })
+}
+
+/// adhesim component (t1, t2, n) of fclib component (N, T1, T2): N → n, T1 → t1, T2 → t2.
+pub fn to_adhesim(fclib_component: usize) -> usize {
+    (fclib_component + 2) % 3
+}
+
+/// fclib component (N, T1, T2) of adhesim component (t1, t2, n).
+pub fn from_adhesim(adhesim_component: usize) -> usize {
+    (adhesim_component + 1) % 3
+}
+
+/// A contact-ordered vector of fclib (N, T1, T2) triples as adhesim (t1, t2, n) triples.
+pub fn triples_to_adhesim(v: &[f64]) -> Vec<[f64; 3]> {
+    v.chunks_exact(3)
+        .map(|c| std::array::from_fn(|a| c[from_adhesim(a)]))
+        .collect()
+}
+
+/// adhesim (t1, t2, n) triples as an fclib (N, T1, T2) vector.
+pub fn triples_to_fclib(v: &[[f64; 3]]) -> Vec<f64> {
+    v.iter()
+        .flat_map(|t| (0..3).map(move |c| t[to_adhesim(c)]))
+        .collect()
+}
+
+/// A local problem x = q + W r in adhesim's order, ready for its solvers.
+#[derive(Clone, Debug)]
+pub struct ReducedProblem {
+    pub w: BlockSparseDelassus,
+    pub q: Vec<[f64; 3]>,
+    pub mu: Vec<f64>,
+}
+
+impl ReducedProblem {
+    /// The local problem of a file, components permuted to (t1, t2, n).
+    pub fn from_local(p: &LocalProblem) -> Self {
+        let perm = |k: usize| 3 * (k / 3) + to_adhesim(k % 3);
+        let w = BlockSparseDelassus::from_entries(
+            p.mu.len(),
+            p.w.entries.iter().map(|&(i, j, v)| (perm(i), perm(j), v)),
+        );
+        Self {
+            w,
+            q: triples_to_adhesim(&p.q),
+            mu: p.mu.clone(),
+        }
+    }
+
+    /// The global problem condensed on the contacts as Siconos does:
+    /// W = Hᵀ M⁻¹ H, q = Hᵀ M⁻¹ f + w, by a dense Cholesky factorisation of M (a diagonal M is
+    /// inverted entry by entry). Exact zeros of W (contacts on bodies that do not interact)
+    /// are not stored. Fails if M is not positive definite.
+    pub fn condense(p: &GlobalProblem) -> Result<Self, String> {
+        let n = p.m.rows;
+        let nc3 = p.h.cols;
+        let h = p.h.to_dense();
+        let (minv_h, minv_f) = if p.m.is_diagonal() {
+            let mut d: DVector<f64> = DVector::zeros(n);
+            for &(i, _, v) in &p.m.entries {
+                d[i] += v;
+            }
+            if let Some(k) = d.iter().position(|&v| v <= 0.0 || !v.is_finite()) {
+                return Err(format!("M[{k},{k}] = {} is not positive", d[k]));
+            }
+            let mut z = h.clone();
+            for (i, mut row) in z.row_iter_mut().enumerate() {
+                row /= d[i];
+            }
+            let f = DVector::from_iterator(n, p.f.iter().zip(d.iter()).map(|(f, d)| f / d));
+            (z, f)
+        } else {
+            let chol =
+                p.m.to_dense()
+                    .cholesky()
+                    .ok_or("M is not positive definite")?;
+            (
+                chol.solve(&h),
+                chol.solve(&DVector::from_column_slice(&p.f)),
+            )
+        };
+        let w_dense = h.transpose() * &minv_h;
+        let q = h.transpose() * minv_f + DVector::from_column_slice(&p.w);
+        let perm = |k: usize| 3 * (k / 3) + to_adhesim(k % 3);
+        let entries = (0..nc3)
+            .flat_map(|i| (0..nc3).map(move |j| (i, j)))
+            .filter(|&(i, j)| w_dense[(i, j)] != 0.0)
+            .map(|(i, j)| (perm(i), perm(j), 0.5 * (w_dense[(i, j)] + w_dense[(j, i)])));
+        let w = BlockSparseDelassus::from_entries(p.mu.len(), entries);
+        Ok(Self {
+            w,
+            q: triples_to_adhesim(q.as_slice()),
+            mu: p.mu.clone(),
+        })
+    }
+
+    /// The problem of a file, condensed if global.
+    pub fn of_file(file: &FclibFile) -> Result<Self, String> {
+        match &file.problem {
+            Problem::Local(p) => Ok(Self::from_local(p)),
+            Problem::Global(p) => Self::condense(p),
+        }
+    }
+
+    /// W as a dense row-major matrix in adhesim's order.
+    pub fn dense_w(&self) -> Vec<f64> {
+        let n = self.w.points();
+        let m = 3 * n;
+        let mut w = vec![0.0; m * m];
+        for p in 0..n {
+            for (j, b) in self.w.row(p) {
+                for a in 0..3 {
+                    for c in 0..3 {
+                        w[(3 * p + a) * m + 3 * j + c] = b[a][c];
+                    }
+                }
+            }
+        }
+        w
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn component_permutation_round_trips() {
+        assert_eq!(to_adhesim(0), 2); // N → n
+        assert_eq!(to_adhesim(1), 0); // T1 → t1
+        assert_eq!(to_adhesim(2), 1); // T2 → t2
+        for c in 0..3 {
+            assert_eq!(from_adhesim(to_adhesim(c)), c);
+        }
+        let v = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        let t = triples_to_adhesim(&v);
+        assert_eq!(t, vec![[2.0, 3.0, 1.0], [5.0, 6.0, 4.0]]);
+        assert_eq!(triples_to_fclib(&t), v.to_vec());
+    }
+}

@@ -1,0 +1,105 @@
+//! Reads the two small fclib problems shipped in tests/data and solves them with adhesim's
+//! contact solvers. Reference values were read independently with h5py/numpy from the same
+//! files (numpy condensed W = Hᵀ M⁻¹ H with a dense solve).
+
+use adhesim::contact::natural_map::{natural_map_residual, relative_error};
+use adhesim::contact::reduced::gauss_seidel_blocks;
+use adhesim::contact::semismooth::semismooth_newton;
+use adhesim_fclib::{read, Problem, ReducedProblem, Storage};
+
+fn data(name: &str) -> String {
+    format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Relative agreement to `tol`.
+fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * b.abs().max(f64::MIN_POSITIVE)
+}
+
+#[test]
+fn reads_lmgc_global_problem() {
+    let file = read(data("LMGC_GFC3D-i00501-4-00000.hdf5")).expect("readable");
+    let Problem::Global(p) = &file.problem else {
+        panic!("a global problem expected")
+    };
+    // Sizes and storage as h5py lists them: M 162×162 with 6174 triplets, H 162×12 with 288.
+    assert_eq!((p.m.rows, p.m.cols, p.m.nnz()), (162, 162, 6174));
+    assert_eq!(p.m.storage, Storage::Triplets);
+    assert_eq!((p.h.rows, p.h.cols, p.h.nnz()), (162, 12, 288));
+    assert_eq!(p.mu, vec![0.3; 4]);
+    assert_eq!((p.f.len(), p.w.len()), (162, 12));
+    // First triplet of M: (0, 0, 498024382.71604985).
+    assert_eq!(p.m.entries[0], (0, 0, 498024382.71604985));
+    assert_eq!(file.title.as_deref(), Some("LMGC dump in hdf5"));
+    assert!(file.solution.is_none() && file.guesses.is_empty());
+    // Condensed W in fclib order (N, T1, T2): W[0,0] = 0.005278594957878928,
+    // W[0,1] = 0.000441442130880571, W[3,5] = -0.00012723061517053017 (contact 1, N and T2),
+    // q[0] = -3.1652235372599938e-12 (numpy); the Cholesky and numpy's LU agree to ~1e-12.
+    let red = ReducedProblem::of_file(&file).expect("M positive definite");
+    let w0 = red.w.diagonal_block(0);
+    // adhesim order (t1, t2, n): fclib (N, N) is (2, 2), (N, T1) is (2, 0).
+    assert!(close(w0[2][2], 0.005278594957878928, 1e-10));
+    assert!(close(w0[2][0], 0.000441442130880571, 1e-10));
+    let w1 = red.w.diagonal_block(1);
+    assert!(close(w1[2][1], -0.00012723061517053017, 1e-10));
+    assert!(close(red.q[0][2], -3.1652235372599938e-12, 1e-8));
+}
+
+#[test]
+fn reads_box_stacks_with_guesses() {
+    let file = read(data("Box_Stacks-i0122-82-5.hdf5")).expect("readable");
+    let Problem::Global(p) = &file.problem else {
+        panic!("a global problem expected")
+    };
+    assert_eq!((p.m.rows, p.m.nnz()), (450, 450));
+    assert!(p.m.is_diagonal());
+    assert_eq!((p.h.rows, p.h.cols, p.h.nnz()), (450, 246, 1284));
+    assert_eq!(p.mu.len(), 82);
+    assert_eq!(p.h.entries[0], (0, 0, -2.2709108060188126e-14));
+    let sol = file.solution.as_ref().expect("a stored solution");
+    assert_eq!(sol.v.as_ref().map(Vec::len), Some(450));
+    let norm_u = sol.u.iter().map(|v| v * v).sum::<f64>().sqrt();
+    assert!(close(norm_u, 0.0021101214190482076, 1e-14));
+    assert_eq!(file.guesses.len(), 1);
+    assert_eq!(file.guesses[0].r.len(), 246);
+}
+
+#[test]
+fn missing_file_names_the_file() {
+    let err = read(data("no-such-problem.hdf5")).unwrap_err().to_string();
+    assert!(err.contains("no-such-problem.hdf5"), "{err}");
+}
+
+/// Both solvers reach Siconos's error 1e-8 on both files; the error reported is recomputed
+/// here from r alone (x = q + W r), and Newton and Gauss-Seidel agree on the normal forces to
+/// 1e-5 of the largest (both errors ≤ 1e-8 relative; the problems are well conditioned enough
+/// for the forces to follow to that level).
+#[test]
+fn solves_small_problems_to_1e8() {
+    for name in [
+        "LMGC_GFC3D-i00501-4-00000.hdf5",
+        "Box_Stacks-i0122-82-5.hdf5",
+    ] {
+        let file = read(data(name)).expect("readable");
+        let p = ReducedProblem::of_file(&file).expect("condensable");
+        let n = p.w.points();
+        let r0 = vec![[0.0; 3]; n];
+        let (newton, _) = semismooth_newton(&p.w, &p.q, &p.mu, &r0, 1e-8, 200);
+        let gs = gauss_seidel_blocks(&p.w, &p.q, &p.mu, &r0, 1e-8, 10_000);
+        for (solver, sol) in [("newton", &newton), ("gauss-seidel", &gs)] {
+            assert!(sol.converged, "{name} {solver}: error {}", sol.error);
+            let mut x = vec![[0.0; 3]; n];
+            p.w.apply(&sol.r, &p.q, &mut x);
+            let res = natural_map_residual(&sol.r, &x, &p.mu);
+            let err = relative_error(res, &p.q, &sol.r, &x);
+            assert!(err <= 1e-8, "{name} {solver}: recomputed error {err}");
+        }
+        let scale = gs.r.iter().map(|r| r[2].abs()).fold(0.0, f64::max);
+        for (a, b) in newton.r.iter().zip(&gs.r) {
+            assert!(
+                (a[2] - b[2]).abs() <= 1e-5 * scale,
+                "{name}: {a:?} vs {b:?}"
+            );
+        }
+    }
+}

@@ -1,0 +1,344 @@
+//! The reduced (Delassus) dry contact problem on its own, without a mesh:
+//! x = q + W r at every contact point, with the Signorini–Coulomb law in its bi-potential form
+//! between r and x (the problem of fclib's local files and of Siconos's `fc3d` solvers).
+//!
+//! W is stored in 3×3 blocks, one per pair of contact points that interact, rows by point
+//! ([`BlockSparseDelassus`]); components are ordered (t1, t2, n) with `r_n > 0` compression and
+//! `x_n ≥ 0` apart, as in [`super::law`]. [`gauss_seidel_blocks`] is the nonlinear Gauss–Seidel
+//! sweep of [`super::solve`] on this storage, point by point with [`solve_point`]; the
+//! semismooth Newton method is in [`super::semismooth`]. Both stop on Siconos's relative error
+//! ([`relative_error`] of [`natural_map_residual`]).
+
+use super::law::{default_rho, solve_point, BondState, InterfaceLaw, PointProblem};
+use super::natural_map::{natural_map_residual, relative_error};
+
+type M3 = [[f64; 3]; 3];
+
+/// A symmetric Delassus operator in 3×3 blocks, compressed by block rows.
+#[derive(Clone, Debug)]
+pub struct BlockSparseDelassus {
+    points: usize,
+    /// Start of each block row in `cols`/`blocks` (points + 1 entries).
+    row_start: Vec<usize>,
+    /// Block column of each stored block, increasing within a row.
+    cols: Vec<usize>,
+    /// The stored blocks, row-major 3×3.
+    blocks: Vec<M3>,
+    /// Index of the diagonal block of each row (always stored, zero if absent from the input).
+    diag: Vec<usize>,
+}
+
+impl BlockSparseDelassus {
+    /// Builds W for `points` contact points from scalar entries (row, column, value), indices
+    /// 3·point + component with components (t1, t2, n). Repeated entries are summed.
+    ///
+    /// # Panics
+    /// If an index is ≥ 3·points.
+    pub fn from_entries(
+        points: usize,
+        entries: impl IntoIterator<Item = (usize, usize, f64)>,
+    ) -> Self {
+        let m = 3 * points;
+        let mut keyed: Vec<(usize, usize, usize, usize, f64)> = entries
+            .into_iter()
+            .map(|(i, j, v)| {
+                assert!(
+                    i < m && j < m,
+                    "entry ({i}, {j}) outside a {m}×{m} operator"
+                );
+                (i / 3, j / 3, i % 3, j % 3, v)
+            })
+            .collect();
+        // Every diagonal block is stored, so each point has its own block to solve with.
+        keyed.extend((0..points).map(|p| (p, p, 0, 0, 0.0)));
+        keyed.sort_unstable_by_key(|e| (e.0, e.1));
+        let mut row_start = vec![0; points + 1];
+        let mut cols = Vec::new();
+        let mut blocks: Vec<M3> = Vec::new();
+        let mut last: Option<(usize, usize)> = None;
+        for (bi, bj, a, b, v) in keyed {
+            if last != Some((bi, bj)) {
+                cols.push(bj);
+                blocks.push([[0.0; 3]; 3]);
+                row_start[bi + 1] += 1;
+                last = Some((bi, bj));
+            }
+            blocks.last_mut().expect("a block was pushed")[a][b] += v;
+        }
+        for p in 0..points {
+            row_start[p + 1] += row_start[p];
+        }
+        let diag = (0..points)
+            .map(|p| {
+                (row_start[p]..row_start[p + 1])
+                    .find(|&k| cols[k] == p)
+                    .expect("diagonal block stored")
+            })
+            .collect();
+        Self {
+            points,
+            row_start,
+            cols,
+            blocks,
+            diag,
+        }
+    }
+
+    /// Builds W from a dense row-major 3N × 3N matrix, keeping the nonzero 3×3 blocks.
+    ///
+    /// # Panics
+    /// If `w.len()` is not (3·points)².
+    pub fn from_dense(points: usize, w: &[f64]) -> Self {
+        let m = 3 * points;
+        assert_eq!(w.len(), m * m, "dense W of {points} points");
+        Self::from_entries(
+            points,
+            (0..m)
+                .flat_map(|i| (0..m).map(move |j| (i, j)))
+                .filter(|&(i, j)| w[i * m + j] != 0.0)
+                .map(|(i, j)| (i, j, w[i * m + j])),
+        )
+    }
+
+    /// Number of contact points N.
+    pub fn points(&self) -> usize {
+        self.points
+    }
+
+    /// Number of stored 3×3 blocks.
+    pub fn block_count(&self) -> usize {
+        self.blocks.len()
+    }
+
+    /// Diagonal block W_pp [m/N].
+    pub fn diagonal_block(&self, p: usize) -> M3 {
+        self.blocks[self.diag[p]]
+    }
+
+    /// The stored blocks of row `p`: (column point, block).
+    pub fn row(&self, p: usize) -> impl Iterator<Item = (usize, &M3)> + '_ {
+        let range = self.row_start[p]..self.row_start[p + 1];
+        self.cols[range.clone()]
+            .iter()
+            .copied()
+            .zip(&self.blocks[range])
+    }
+
+    /// W + η I [m/N].
+    pub fn with_diagonal_shift(&self, eta: f64) -> Self {
+        let mut shifted = self.clone();
+        for &k in &shifted.diag {
+            for a in 0..3 {
+                shifted.blocks[k][a][a] += eta;
+            }
+        }
+        shifted
+    }
+
+    /// x = q + W r.
+    pub fn apply(&self, r: &[[f64; 3]], q: &[[f64; 3]], x: &mut [[f64; 3]]) {
+        for p in 0..self.points {
+            x[p] = self.row_times(p, r, q[p], None);
+        }
+    }
+
+    /// `start` + Σ_j W_pj r_j over the stored blocks of row p, skipping column `skip`.
+    fn row_times(
+        &self,
+        p: usize,
+        r: &[[f64; 3]],
+        start: [f64; 3],
+        skip: Option<usize>,
+    ) -> [f64; 3] {
+        let mut acc = start;
+        for (j, b) in self.row(p) {
+            if Some(j) == skip {
+                continue;
+            }
+            let rj = r[j];
+            for a in 0..3 {
+                acc[a] += b[a][0] * rj[0] + b[a][1] * rj[1] + b[a][2] * rj[2];
+            }
+        }
+        acc
+    }
+}
+
+/// Solution of a reduced contact problem.
+#[derive(Clone, Debug)]
+pub struct ReducedSolution {
+    /// Contact forces per point, (t1, t2, n).
+    pub r: Vec<[f64; 3]>,
+    /// Relative displacements x = q + W r per point.
+    pub x: Vec<[f64; 3]>,
+    /// Iterations: sweeps for Gauss–Seidel, Newton steps (plus fallback sweeps) for Newton.
+    pub iterations: usize,
+    /// Natural-map residual ‖F‖ (unnormalised, ρ = 1).
+    pub residual: f64,
+    /// Relative error: `residual` / max(‖q‖, ‖r‖, ‖x‖).
+    pub error: f64,
+    /// Whether `error` ≤ the requested tolerance.
+    pub converged: bool,
+}
+
+/// x = q + W r and Siconos's error of (r, x): (residual, relative error).
+pub fn error_of(
+    w: &BlockSparseDelassus,
+    q: &[[f64; 3]],
+    mu: &[f64],
+    r: &[[f64; 3]],
+    x: &mut [[f64; 3]],
+) -> (f64, f64) {
+    w.apply(r, q, x);
+    let res = natural_map_residual(r, x, mu);
+    (res, relative_error(res, q, r, x))
+}
+
+/// ρ per point for the bi-potential maps: 1/λ_max of the diagonal block ([`default_rho`]).
+pub fn point_rhos(w: &BlockSparseDelassus) -> Vec<f64> {
+    (0..w.points())
+        .map(|p| default_rho(w.diagonal_block(p)))
+        .collect()
+}
+
+/// One nonlinear Gauss–Seidel sweep in place: each point in turn solves its dry law exactly
+/// ([`solve_point`]) with the others' current forces. `rho` as from [`point_rhos`].
+pub fn gauss_seidel_sweep(
+    w: &BlockSparseDelassus,
+    q: &[[f64; 3]],
+    mu: &[f64],
+    rho: &[f64],
+    r: &mut [[f64; 3]],
+) {
+    for p in 0..w.points() {
+        let x_free = w.row_times(p, r, q[p], Some(p));
+        let law = InterfaceLaw {
+            mu: mu[p],
+            adhesion: None,
+        };
+        let problem = PointProblem {
+            w_aa: w.diagonal_block(p),
+            x_free,
+            law: &law,
+            bond0: BondState::default(),
+            dt: 1.0,
+            area: 1.0,
+            rho: rho[p],
+        };
+        r[p] = solve_point(&problem, r[p], 1e-12, 200).r_dry;
+    }
+}
+
+/// Nonlinear Gauss–Seidel on block-sparse W from `r_start` until Siconos's relative error is
+/// ≤ `tol` (checked after every sweep) or `max_sweeps` sweeps.
+///
+/// # Panics
+/// If `q`, `mu` or `r_start` do not have one entry per point.
+pub fn gauss_seidel_blocks(
+    w: &BlockSparseDelassus,
+    q: &[[f64; 3]],
+    mu: &[f64],
+    r_start: &[[f64; 3]],
+    tol: f64,
+    max_sweeps: usize,
+) -> ReducedSolution {
+    let n = w.points();
+    assert!(q.len() == n && mu.len() == n && r_start.len() == n);
+    let rho = point_rhos(w);
+    let mut r = r_start.to_vec();
+    let mut x = vec![[0.0; 3]; n];
+    let (mut residual, mut error) = error_of(w, q, mu, &r, &mut x);
+    let mut sweeps = 0;
+    while error > tol && sweeps < max_sweeps {
+        gauss_seidel_sweep(w, q, mu, &rho, &mut r);
+        sweeps += 1;
+        (residual, error) = error_of(w, q, mu, &r, &mut x);
+    }
+    ReducedSolution {
+        r,
+        x,
+        iterations: sweeps,
+        residual,
+        error,
+        converged: error <= tol,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sym_pd(points: usize, seed: u64) -> Vec<f64> {
+        // A = B Bᵀ + I with a fixed pseudo-random B.
+        let m = 3 * points;
+        let mut s = seed;
+        let mut rnd = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        let b: Vec<f64> = (0..m * m).map(|_| rnd()).collect();
+        let mut a = vec![0.0; m * m];
+        for i in 0..m {
+            for j in 0..m {
+                a[i * m + j] = (0..m).map(|k| b[i * m + k] * b[j * m + k]).sum::<f64>() / m as f64;
+            }
+            a[i * m + i] += 1.0;
+        }
+        a
+    }
+
+    /// The block storage reproduces the dense product, and repeated entries are summed.
+    #[test]
+    fn block_storage_matches_dense() {
+        let n = 4;
+        let w = sym_pd(n, 3);
+        let bw = BlockSparseDelassus::from_dense(n, &w);
+        assert_eq!(bw.block_count(), n * n);
+        let r: Vec<[f64; 3]> = (0..n).map(|p| [p as f64, 1.0 - p as f64, 0.5]).collect();
+        let q = vec![[0.1, 0.2, 0.3]; n];
+        let mut x = vec![[0.0; 3]; n];
+        bw.apply(&r, &q, &mut x);
+        for i in 0..3 * n {
+            let dense: f64 = q[i / 3][i % 3]
+                + (0..3 * n)
+                    .map(|j| w[i * 3 * n + j] * r[j / 3][j % 3])
+                    .sum::<f64>();
+            assert!((x[i / 3][i % 3] - dense).abs() < 1e-13);
+        }
+        let twice = BlockSparseDelassus::from_entries(1, [(2, 2, 1.5), (2, 2, 0.5), (0, 1, 3.0)]);
+        assert_eq!(twice.diagonal_block(0)[2][2], 2.0);
+        assert_eq!(twice.diagonal_block(0)[0][1], 3.0);
+    }
+
+    /// One point pressed with a free gap of −d and no tangential load: r_n = d/W_nn exactly.
+    #[test]
+    fn single_point_normal_closed_form() {
+        let w = BlockSparseDelassus::from_entries(1, [(0, 0, 2.0), (1, 1, 2.0), (2, 2, 4.0)]);
+        let q = [[0.0, 0.0, -0.2]];
+        let sol = gauss_seidel_blocks(&w, &q, &[0.3], &[[0.0; 3]], 1e-12, 10);
+        assert!(sol.converged);
+        assert!((sol.r[0][2] - 0.05).abs() < 1e-14);
+    }
+
+    /// Coupled points: Gauss–Seidel reaches the tolerance and the natural map vanishes.
+    #[test]
+    fn coupled_points_converge() {
+        let n = 5;
+        let w = BlockSparseDelassus::from_dense(n, &sym_pd(n, 11));
+        let q: Vec<[f64; 3]> = (0..n)
+            .map(|p| {
+                [
+                    0.3 - 0.1 * p as f64,
+                    0.2,
+                    if p % 2 == 0 { -1.0 } else { 0.4 },
+                ]
+            })
+            .collect();
+        let mu = vec![0.5; n];
+        let sol = gauss_seidel_blocks(&w, &q, &mu, &vec![[0.0; 3]; n], 1e-10, 2000);
+        assert!(sol.converged, "error {}", sol.error);
+        assert!(sol.r.iter().any(|r| r[2] > 0.0));
+    }
+}
