@@ -140,58 +140,25 @@ struct FileMeshFile {
 enum FileGenerator {
     Block {
         size: [f64; 3],
-        #[serde(deserialize_with = "whole_counts")]
         divisions: [usize; 3],
     },
     Disk {
         radius: f64,
         thickness: f64,
-        #[serde(deserialize_with = "whole_count")]
         n_quarter: usize,
-        #[serde(deserialize_with = "whole_count")]
         n_radial: usize,
     },
     HalfDisk {
         radius: f64,
         thickness: f64,
-        #[serde(deserialize_with = "whole_count")]
         n_quarter: usize,
-        #[serde(deserialize_with = "whole_count")]
         n_radial: usize,
         flat_side: String,
     },
     QuarterHemisphere {
         radius: f64,
-        #[serde(deserialize_with = "whole_count")]
         n: usize,
     },
-}
-
-/// Checks that `x` is a whole number of elements (an expression such as `"= 2 * n"` gives a
-/// float, which is accepted when it is whole).
-fn whole_number(x: f64) -> Result<usize, String> {
-    if x.is_finite() && x >= 0.0 && x.fract() == 0.0 && x < 2f64.powi(53) {
-        Ok(x as usize)
-    } else {
-        Err(format!("expected a whole number ≥ 0, found {x}"))
-    }
-}
-
-/// Deserialises a count of elements: an integer, or the whole value of an expression.
-fn whole_count<'de, D: serde::Deserializer<'de>>(d: D) -> Result<usize, D::Error> {
-    use serde::de::Error as _;
-    whole_number(f64::deserialize(d)?).map_err(D::Error::custom)
-}
-
-/// As [`whole_count`] for the three divisions of a block.
-fn whole_counts<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[usize; 3], D::Error> {
-    use serde::de::Error as _;
-    let x = <[f64; 3]>::deserialize(d)?;
-    let mut n = [0; 3];
-    for (n, x) in n.iter_mut().zip(x) {
-        *n = whole_number(x).map_err(D::Error::custom)?;
-    }
-    Ok(n)
 }
 
 #[derive(Deserialize, Debug)]
