@@ -85,6 +85,73 @@ fn table_without_wall_time(dir: &Path) -> Vec<Vec<String>> {
         .collect()
 }
 
+/// The physical kind of a summary column (`<owner>.<field>.<stat>`), so that numbers are
+/// compared against the size of quantities of their own kind.
+fn kind(column: &str) -> &'static str {
+    let parts: Vec<&str> = column.split('.').collect();
+    let field = if parts.len() >= 3 {
+        parts[parts.len() - 2]
+    } else {
+        column
+    };
+    let field = field.trim_end_matches("_norm_sum");
+    match field {
+        f if f.starts_with("ft") || f.starts_with("rt") || f.starts_with("rn") => "force",
+        "fx" | "fy" | "fz" | "fn" | "fn_adh" | "Fx" | "Fy" | "Fz" => "force",
+        "pn" | "pn_adh" | "tt" | "tt_adh" => "traction",
+        "ux" | "uy" | "uz" | "gap" | "slip" => "length",
+        "vx" | "vy" | "vz" => "velocity",
+        "Mx" | "My" | "Mz" => "moment",
+        _ => "other",
+    }
+}
+
+/// The two tables have the same shape and text, and their numbers agree to round-off against
+/// the size of quantities of the same kind (1e-8 of the largest force, traction, length, ...
+/// of the table). A task under Slurm and a local case take the same steps, but not always
+/// the same last bits (the sums of the parallel sparse factorisation), and stick-slip and the
+/// bonds amplify them in quantities that are zero in exact arithmetic, such as a symmetric
+/// indentation's sideways force (4e-8 N against a normal force of 229 N).
+fn assert_tables_match(a: &[Vec<String>], b: &[Vec<String>]) {
+    assert_eq!(a.len(), b.len(), "row counts differ");
+    let header = &a[0];
+    let mut scale: std::collections::HashMap<&str, f64> = std::collections::HashMap::new();
+    for row in a.iter().chain(b).skip(1) {
+        for (x, col) in row.iter().zip(header) {
+            if let Ok(v) = x.parse::<f64>() {
+                let k = if kind(col) == "other" {
+                    col.as_str()
+                } else {
+                    kind(col)
+                };
+                let e = scale.entry(k).or_insert(0.0);
+                *e = e.max(v.abs());
+            }
+        }
+    }
+    for (ra, rb) in a.iter().zip(b) {
+        assert_eq!(ra.len(), rb.len(), "row lengths differ: {ra:?} / {rb:?}");
+        for ((x, y), col) in ra.iter().zip(rb).zip(header) {
+            match (x.parse::<f64>(), y.parse::<f64>()) {
+                (Ok(u), Ok(v)) => {
+                    let k = if kind(col) == "other" {
+                        col.as_str()
+                    } else {
+                        kind(col)
+                    };
+                    let tol = 1e-8 * scale[k];
+                    assert!(
+                        (u - v).abs() <= tol,
+                        "case {}, column {col}: {x} against {y} (tolerance {tol:e})",
+                        ra[0]
+                    );
+                }
+                _ => assert_eq!(x, y, "case {}, column {col}", ra[0]),
+            }
+        }
+    }
+}
+
 fn run_json(dir: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(dir.join("run.json")).unwrap()).unwrap()
 }
@@ -230,9 +297,9 @@ fn a_job_array_sweep_with_a_cancelled_task_collects_to_the_local_table() {
         .output()
         .unwrap();
     assert!(o.status.success(), "collect: {o:?}");
-    assert_eq!(
-        table_without_wall_time(&array),
-        table_without_wall_time(&local)
+    assert_tables_match(
+        &table_without_wall_time(&array),
+        &table_without_wall_time(&local),
     );
     assert!(array.join("figures").read_dir().unwrap().next().is_some());
 }
