@@ -385,10 +385,10 @@ fn hertz_force_and_contact_radius_converge_to_the_half_space_solution() {
     }
 }
 
-/// The same indentation with every one of the 2,016 surface nodes of the h = a/8 mesh a
+/// The same indentation with every one of the 2,219 surface nodes of the h = a/8 mesh a
 /// contact candidate (the detection distance spans the whole face, so most candidates are
 /// apart and must be found so): the contact solve without the Delassus operator handles them
-/// in the same sparse Newton iterations. W would be 6,048² values (290 MB) built from 6,048
+/// in the same sparse Newton iterations. W would be 6,657² values (355 MB) built from 6,657
 /// solves, which is why the Gauss-Seidel solver is not run here. Tolerance 3 %: the h = a/8
 /// mesh is between the a/6 and a/9 meshes of the convergence test above (within 1 %), and
 /// the candidates far from the sphere must not change the answer.
