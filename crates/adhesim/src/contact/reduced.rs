@@ -264,29 +264,44 @@ pub fn gauss_seidel_blocks(
     }
 }
 
+/// Reproducible random problems for the tests of the reduced solvers.
 #[cfg(test)]
-mod tests {
-    use super::*;
+pub(crate) mod test_support {
+    /// A linear congruential generator of numbers in [−½, ½).
+    pub(crate) struct Lcg(pub(crate) u64);
 
-    fn sym_pd(points: usize, seed: u64) -> Vec<f64> {
-        // A = B Bᵀ + I with a fixed pseudo-random B.
-        let m = 3 * points;
-        let mut s = seed;
-        let mut rnd = || {
-            s = s
+    impl Lcg {
+        pub(crate) fn next_centered(&mut self) -> f64 {
+            self.0 = self
+                .0
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
-            ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
-        let b: Vec<f64> = (0..m * m).map(|_| rnd()).collect();
+            ((self.0 >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        }
+    }
+
+    /// A = B Bᵀ/m + shift·I (m × m, row-major) with B drawn from `rng`: symmetric positive
+    /// definite.
+    pub(crate) fn random_spd(rng: &mut Lcg, m: usize, shift: f64) -> Vec<f64> {
+        let b: Vec<f64> = (0..m * m).map(|_| rng.next_centered()).collect();
         let mut a = vec![0.0; m * m];
         for i in 0..m {
             for j in 0..m {
                 a[i * m + j] = (0..m).map(|k| b[i * m + k] * b[j * m + k]).sum::<f64>() / m as f64;
             }
-            a[i * m + i] += 1.0;
+            a[i * m + i] += shift;
         }
         a
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::test_support::{random_spd, Lcg};
+    use super::*;
+
+    fn sym_pd(points: usize, seed: u64) -> Vec<f64> {
+        random_spd(&mut Lcg(seed), 3 * points, 1.0)
     }
 
     /// The block storage reproduces the dense product, and repeated entries are summed.

@@ -310,25 +310,13 @@ const PROX_INNER: usize = 50;
 #[cfg(test)]
 mod tests {
     use super::super::reduced::gauss_seidel_blocks;
+    use super::super::reduced::test_support::{random_spd, Lcg};
     use super::*;
 
     fn problem(n: usize, seed: u64) -> (BlockSparseDelassus, Vec<[f64; 3]>) {
-        let m = 3 * n;
-        let mut s = seed;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
-        let b: Vec<f64> = (0..m * m).map(|_| rnd()).collect();
-        let mut a = vec![0.0; m * m];
-        for i in 0..m {
-            for j in 0..m {
-                a[i * m + j] = (0..m).map(|k| b[i * m + k] * b[j * m + k]).sum::<f64>() / m as f64;
-            }
-            a[i * m + i] += 0.2;
-        }
+        let mut rng = Lcg(seed);
+        let a = random_spd(&mut rng, 3 * n, 0.2);
+        let mut rnd = || rng.next_centered();
         let q = (0..n).map(|_| [rnd(), rnd(), rnd() - 0.3]).collect();
         (BlockSparseDelassus::from_dense(n, &a), q)
     }

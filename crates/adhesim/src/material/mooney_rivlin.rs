@@ -1,8 +1,7 @@
 //! Nearly incompressible Mooney-Rivlin material (uncoupled form).
 
 use super::uncoupled::{self, Isochoric, Tensor4};
-use super::Hyperelastic;
-use crate::{Mat3, Mat6};
+use crate::Mat3;
 
 /// Mooney-Rivlin with a volumetric/isochoric split, as in Abaqus and FEBio:
 ///
@@ -55,37 +54,13 @@ impl Isochoric for MooneyRivlin {
     }
 }
 
-impl Hyperelastic for MooneyRivlin {
-    /// W [J/m³]; +∞ when det C ≤ 0 (or is NaN).
-    fn energy(&self, c: &Mat3) -> f64 {
-        uncoupled::energy(self, self.kappa, c)
-    }
-
-    fn pk2(&self, c: &Mat3) -> Mat3 {
-        uncoupled::pk2(self, self.kappa, c)
-    }
-
-    fn pk2_and_tangent(&self, c: &Mat3) -> (Mat3, Mat6) {
-        uncoupled::pk2_and_tangent(self, self.kappa, c)
-    }
-
-    fn shear_modulus(&self) -> f64 {
-        2.0 * (self.c10 + self.c01)
-    }
-
-    fn bulk_modulus(&self) -> f64 {
-        self.kappa
-    }
-
-    fn isochoric_pk2_and_tangent(&self, c: &Mat3) -> Option<(Mat3, Mat6)> {
-        Some(uncoupled::pk2_and_tangent(self, 0.0, c))
-    }
-}
+uncoupled::uncoupled_hyperelastic!(MooneyRivlin, |m| 2.0 * (m.c10 + m.c01));
 
 #[cfg(test)]
 mod tests {
     use super::super::test_support::*;
     use super::*;
+    use crate::material::Hyperelastic;
 
     /// A rubber with a strong second invariant term and ν ≈ 0.4999 (κ/μ = 5000).
     fn material() -> MooneyRivlin {

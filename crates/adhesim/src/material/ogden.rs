@@ -1,8 +1,7 @@
 //! Nearly incompressible Ogden material (uncoupled form, N terms).
 
 use super::uncoupled::{self, Isochoric, Tensor4};
-use super::Hyperelastic;
-use crate::{Mat3, Mat6};
+use crate::Mat3;
 
 /// Ogden with a volumetric/isochoric split, in the Abaqus convention (`HYPERELASTIC, OGDEN`):
 ///
@@ -121,38 +120,14 @@ impl Isochoric for Ogden {
     }
 }
 
-impl Hyperelastic for Ogden {
-    /// W [J/m³]; +∞ when det C ≤ 0 (or is NaN).
-    fn energy(&self, c: &Mat3) -> f64 {
-        uncoupled::energy(self, self.kappa, c)
-    }
-
-    fn pk2(&self, c: &Mat3) -> Mat3 {
-        uncoupled::pk2(self, self.kappa, c)
-    }
-
-    fn pk2_and_tangent(&self, c: &Mat3) -> (Mat3, Mat6) {
-        uncoupled::pk2_and_tangent(self, self.kappa, c)
-    }
-
-    fn shear_modulus(&self) -> f64 {
-        self.mu.iter().sum()
-    }
-
-    fn bulk_modulus(&self) -> f64 {
-        self.kappa
-    }
-
-    fn isochoric_pk2_and_tangent(&self, c: &Mat3) -> Option<(Mat3, Mat6)> {
-        Some(uncoupled::pk2_and_tangent(self, 0.0, c))
-    }
-}
+uncoupled::uncoupled_hyperelastic!(Ogden, |m| m.mu.iter().sum());
 
 #[cfg(test)]
 mod tests {
     use super::super::test_support::*;
     use super::super::{MooneyRivlin, UncoupledNeoHookean};
     use super::*;
+    use crate::material::Hyperelastic;
 
     /// Ogden's three-term fit of Treloar's rubber data (Ogden 1972: μₚ = 0.63, 0.0012,
     /// −0.01 MPa with W = Σ μₚ/αₚ (…)), converted to the convention here (μᵢ = μₚαₚ/2),

@@ -29,6 +29,45 @@ pub(crate) trait Isochoric {
     fn iso_stress_and_tangent(&self, cbar: &Mat3) -> (Mat3, Option<Tensor4>);
 }
 
+/// `Hyperelastic` for a material whose isochoric part implements [`Isochoric`] and whose bulk
+/// modulus is its field `kappa`: energy, stress and tangent through this module's split, and
+/// the small-strain shear modulus given as a function of the material.
+macro_rules! uncoupled_hyperelastic {
+    ($material:ty, $shear_modulus:expr) => {
+        impl $crate::material::Hyperelastic for $material {
+            /// W [J/m³]; +∞ when det C ≤ 0 (or is NaN).
+            fn energy(&self, c: &$crate::Mat3) -> f64 {
+                $crate::material::uncoupled::energy(self, self.kappa, c)
+            }
+
+            fn pk2(&self, c: &$crate::Mat3) -> $crate::Mat3 {
+                $crate::material::uncoupled::pk2(self, self.kappa, c)
+            }
+
+            fn pk2_and_tangent(&self, c: &$crate::Mat3) -> ($crate::Mat3, $crate::Mat6) {
+                $crate::material::uncoupled::pk2_and_tangent(self, self.kappa, c)
+            }
+
+            fn shear_modulus(&self) -> f64 {
+                let shear: fn(&$material) -> f64 = $shear_modulus;
+                shear(self)
+            }
+
+            fn bulk_modulus(&self) -> f64 {
+                self.kappa
+            }
+
+            fn isochoric_pk2_and_tangent(
+                &self,
+                c: &$crate::Mat3,
+            ) -> Option<($crate::Mat3, $crate::Mat6)> {
+                Some($crate::material::uncoupled::pk2_and_tangent(self, 0.0, c))
+            }
+        }
+    };
+}
+pub(crate) use uncoupled_hyperelastic;
+
 /// W(C) = W̄(C̄) + κ/2 (J − 1)²; +∞ when det C ≤ 0 (or is NaN).
 pub(crate) fn energy(iso: &impl Isochoric, kappa: f64, c: &Mat3) -> f64 {
     let i3 = c.determinant();

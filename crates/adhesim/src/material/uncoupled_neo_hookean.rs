@@ -1,8 +1,7 @@
 //! Nearly incompressible neo-Hookean material (uncoupled form).
 
 use super::uncoupled::{self, Isochoric, Tensor4};
-use super::Hyperelastic;
-use crate::{Mat3, Mat6};
+use crate::Mat3;
 
 /// Neo-Hookean with a volumetric/isochoric split, as in Abaqus (`NEO HOOKE`) and FEBio
 /// (`uncoupled` materials):
@@ -44,38 +43,14 @@ impl Isochoric for UncoupledNeoHookean {
     }
 }
 
-impl Hyperelastic for UncoupledNeoHookean {
-    /// W [J/m³]; +∞ when det C ≤ 0 (or is NaN).
-    fn energy(&self, c: &Mat3) -> f64 {
-        uncoupled::energy(self, self.kappa, c)
-    }
-
-    fn pk2(&self, c: &Mat3) -> Mat3 {
-        uncoupled::pk2(self, self.kappa, c)
-    }
-
-    fn pk2_and_tangent(&self, c: &Mat3) -> (Mat3, Mat6) {
-        uncoupled::pk2_and_tangent(self, self.kappa, c)
-    }
-
-    fn shear_modulus(&self) -> f64 {
-        2.0 * self.c10
-    }
-
-    fn bulk_modulus(&self) -> f64 {
-        self.kappa
-    }
-
-    fn isochoric_pk2_and_tangent(&self, c: &Mat3) -> Option<(Mat3, Mat6)> {
-        Some(uncoupled::pk2_and_tangent(self, 0.0, c))
-    }
-}
+uncoupled::uncoupled_hyperelastic!(UncoupledNeoHookean, |m| 2.0 * m.c10);
 
 #[cfg(test)]
 mod tests {
     use super::super::test_support::*;
     use super::super::MooneyRivlin;
     use super::*;
+    use crate::material::Hyperelastic;
 
     /// PDMS-like: E = 1 MPa, ν = 0.4999.
     fn material() -> UncoupledNeoHookean {
