@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 pub const FILE_NAME: &str = "checkpoint.bin";
 
 const MAGIC: &[u8; 8] = b"ADHCKPT\0";
-const FORMAT: u32 = 2;
+const FORMAT: u32 = 3;
 
 /// A run's state after a committed step.
 #[derive(Clone, Debug, PartialEq)]
@@ -199,6 +199,7 @@ impl Checkpoint {
                     slip,
                     state,
                     tangent_axes,
+                    damage,
                 } = c;
                 w.f64(*beta);
                 ut.iter()
@@ -208,6 +209,7 @@ impl Checkpoint {
                     .chain([gap])
                     .chain(slip)
                     .chain(tangent_axes.iter().flatten())
+                    .chain([damage])
                     .for_each(|x| w.f64(*x));
                 w.0.extend_from_slice(&state.to_le_bytes());
             }
@@ -271,11 +273,11 @@ impl Checkpoint {
         let pairs = r.len(8)?;
         let mut contact = Vec::with_capacity(pairs);
         for _ in 0..pairs {
-            let n = r.len(8 * 22 + 4)?;
+            let n = r.len(8 * 23 + 4)?;
             let mut nodes = Vec::with_capacity(n);
             for _ in 0..n {
-                // β, then 3 + 3 + 3 + 3 + 1 + 2 + 6 values, then the state.
-                let mut x = [0.0; 21];
+                // β, then 3 + 3 + 3 + 3 + 1 + 2 + 6 + 1 values, then the state.
+                let mut x = [0.0; 22];
                 let beta = r.f64()?;
                 for xi in &mut x {
                     *xi = r.f64()?;
@@ -292,6 +294,7 @@ impl Checkpoint {
                     slip: [x[13], x[14]],
                     state,
                     tangent_axes: [a3(15), a3(18)],
+                    damage: x[21],
                 });
             }
             contact.push(nodes);
@@ -427,6 +430,7 @@ mod tests {
             slip: [1e-300, -0.0],
             state: 3,
             tangent_axes: [[1.0, 0.0, 0.0], [0.0, 1.0 / 3.0, 0.7]],
+            damage: 0.125,
         };
         Checkpoint {
             version: "0.1.0".into(),

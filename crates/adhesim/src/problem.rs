@@ -120,7 +120,7 @@ pub struct Body {
     pub element: crate::fbar::Formulation,
 }
 
-/// Time integration settings (model.md §3).
+/// Time integration settings (docs/model.md §3).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TimeSettings {
     /// End time [s].

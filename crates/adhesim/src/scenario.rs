@@ -5,7 +5,7 @@
 //! that is wrong and what would be valid. The format is documented in `docs/scenario.md`.
 
 use crate::contact::detect::tributary_areas;
-use crate::contact::law::DEFAULT_BETA_EPS;
+use crate::contact::law::{Orthotropy, DEFAULT_BETA_EPS};
 use crate::contact::{ContactPair, InterfaceLaw, Master, RccParams, RigidMotion, RigidShape};
 use crate::material::{self, Hyperelastic};
 use crate::mesh::generate::{self, FlatSide};
@@ -237,7 +237,18 @@ struct FileContact {
     #[serde(default)]
     adhesion: Option<FileAdhesion>,
     #[serde(default)]
+    orthotropy: Option<FileOrthotropy>,
+    #[serde(default)]
     detection_distance: Option<f64>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct FileOrthotropy {
+    axis: [f64; 3],
+    friction_2: f64,
+    #[serde(default)]
+    ct_2: Option<f64>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -277,6 +288,7 @@ struct FileAdhesion {
     ct: f64,
     b: f64,
     eps: Option<f64>,
+    fatigue_energy: Option<f64>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -1538,12 +1550,62 @@ fn build_contact(
             if !(eps > 0.0 && eps < 1.0) {
                 return Err(ctx.err(format!("`{key}.adhesion.eps` must be in (0, 1), got {eps}")));
             }
+            let fatigue_energy = match a.fatigue_energy {
+                None => f64::INFINITY,
+                Some(d) => ctx.positive(&format!("{key}.adhesion.fatigue_energy"), d)?,
+            };
             Some(RccParams {
                 w,
                 cn,
                 ct: a.ct,
+                ct2: a.ct,
                 b: a.b,
                 eps,
+                fatigue_energy,
+            })
+        }
+    };
+    let mut adhesion = adhesion;
+    let anisotropy = match &c.orthotropy {
+        None => None,
+        Some(o) => {
+            let k = format!("{key}.orthotropy");
+            let len = o.axis.iter().map(|v| v * v).sum::<f64>().sqrt();
+            if !(len.is_finite() && len > 0.0) {
+                return Err(ctx.err(format!(
+                    "`{k}.axis` must be a non-zero direction (the first material axis of the master surface, global components), got {:?}",
+                    o.axis
+                )));
+            }
+            let mu2 = o.friction_2;
+            if !(mu2.is_finite() && mu2 >= 0.0) {
+                return Err(ctx.err(format!(
+                    "`{k}.friction_2` must be a finite number ≥ 0 (the friction coefficient along the second axis), got {mu2}"
+                )));
+            }
+            if mu2 != mu && (mu == 0.0 || mu2 == 0.0) {
+                return Err(ctx.err(format!(
+                    "`{key}.friction` ({mu}) and `{k}.friction_2` ({mu2}) must both be positive for an elliptic friction cone (or equal)"
+                )));
+            }
+            if let Some(ct2) = o.ct_2 {
+                match adhesion.as_mut() {
+                    None => {
+                        return Err(ctx.err(format!(
+                            "`{k}.ct_2` needs an `adhesion` block on the pair (it is the tangential adhesive stiffness along the second axis)"
+                        )))
+                    }
+                    Some(a) if ct2.is_finite() && ct2 >= 0.0 => a.ct2 = ct2,
+                    Some(_) => {
+                        return Err(ctx.err(format!(
+                            "`{k}.ct_2` must be a finite number ≥ 0 [N/m³], got {ct2}"
+                        )))
+                    }
+                }
+            }
+            Some(Orthotropy {
+                axis: o.axis.map(|v| v / len),
+                mu2,
             })
         }
     };
@@ -1556,7 +1618,11 @@ fn build_contact(
         slave_nodes,
         slave_area: area,
         master,
-        law: InterfaceLaw { mu, adhesion },
+        law: InterfaceLaw {
+            mu,
+            adhesion,
+            anisotropy,
+        },
         detection_distance,
         slave_quads,
     })

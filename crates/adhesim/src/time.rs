@@ -1,4 +1,4 @@
-//! One NSCD θ-method step (model.md §3) with its Newton loop and Δt cut-back.
+//! One NSCD θ-method step (docs/model.md §3) with its Newton loop and Δt cut-back.
 //!
 //! Over [t, t+Δt] with known u₀, v₀ and unknown u₁:
 //!   v₁ = (u₁ − u₀)/(θΔt) − (1−θ)/θ · v₀
@@ -7,15 +7,27 @@
 //!   K̄ = ξ K + ξ/(θΔt) A + M/(θΔt²)
 //! The quasi-static mode drops M and A: G = F_int(u₁) − F_ext¹ − R₁, K̄ = K.
 
-use crate::assembly::{BadElement, Discretisation};
+mod constraints;
+mod coupling;
+mod delassus_coupling;
+mod integrator;
+mod newton_coupling;
+
+pub use constraints::Constraints;
+
+use crate::assembly::{Assembled, BadElement, Discretisation};
+use crate::contact::anisotropic::align_frames;
 use crate::contact::detect::{detect, ContactPoint};
-use crate::contact::law::{BondState, ContactState, PointSolution};
-use crate::contact::newton::{self, augmented_point, bipotential_projection, AugmentedPoint};
-use crate::contact::solve::{delassus, gauss_seidel, Delassus};
+use crate::contact::law::{accumulated_damage, BondState, ContactState, PointSolution};
 use crate::linalg::LinalgError;
 use crate::problem::{ContactSolver, Problem};
 use crate::system::SystemMatrix;
+use coupling::{Candidates, ContactCoupling, Evaluated, Iterate, StepContact};
+use delassus_coupling::{DelassusCache, DelassusCoupling};
+use integrator::{norm, Inertia, Scheme, ThetaStep, Workspace};
+use newton_coupling::NewtonCoupling;
 use std::sync::Arc;
+use std::time::Instant;
 
 /// Why a run could not be set up.
 #[derive(Debug, thiserror::Error)]
@@ -122,6 +134,10 @@ pub struct NodeContact {
     pub state: i32,
     /// Tangent axes T₁, T₂ of the local frame (global components).
     pub tangent_axes: [[f64; 3]; 2],
+    /// Adhesive energy dissipated at the node so far, D [J/m²]: the interface's memory of
+    /// past debonding, which the fatigue law degrades the decohesion energy with (kept when
+    /// the node leaves contact).
+    pub damage: f64,
 }
 
 /// The state of the bodies.
@@ -176,11 +192,10 @@ pub struct Stepper {
     pub disc: Discretisation,
     /// Committed state.
     pub state: State,
-    mass: Vec<f64>,
-    damping: Option<Vec<f64>>,
+    inertia: Inertia,
     gravity_force: Vec<f64>,
     system: SystemMatrix,
-    constrained: Vec<bool>,
+    constraints: Constraints,
     dt: f64,
     good_steps_since_cut: usize,
     f_ext0: Vec<f64>,
@@ -191,10 +206,12 @@ pub struct Stepper {
     pub contact: Vec<Vec<NodeContact>>,
     /// Diagonal of the bounding box of the reference nodes [m].
     model_size: f64,
-    /// The last Delassus operator and what it was built for (see [`delassus_key`]).
-    delassus_cache: Option<(Vec<u64>, Delassus)>,
+    /// The last Delassus operator, kept for reuse by the Gauss-Seidel contact solve.
+    delassus_cache: DelassusCache,
     /// Nodal reaction forces of the last committed step [N] (see [`Stepper::reactions`]).
     reactions: Vec<f64>,
+    /// Buffers of the Newton loop.
+    workspace: Workspace,
 }
 
 struct Attempt {
@@ -242,17 +259,8 @@ impl Stepper {
         }
         let mut gravity_force = vec![0.0; n];
         disc.pattern.symmetric_matvec(&mass, &g, &mut gravity_force);
-        let mut constrained = vec![false; n];
-        for d in &problem.dirichlet {
-            for &node in &d.nodes {
-                for k in 0..3 {
-                    if d.components[k] {
-                        constrained[3 * node + k] = true;
-                    }
-                }
-            }
-        }
-        let system = SystemMatrix::new(disc.pattern.clone(), constrained.clone())?;
+        let constraints = Constraints::new(&problem.dirichlet, n);
+        let system = SystemMatrix::new(disc.pattern.clone(), constraints.mask().to_vec())?;
         let mut v0 = vec![0.0; n];
         let offsets = problem.node_offsets();
         for (b, off) in problem.bodies.iter().zip(offsets) {
@@ -271,11 +279,10 @@ impl Stepper {
             problem,
             disc,
             state,
-            mass,
-            damping,
+            inertia: Inertia { mass, damping },
             gravity_force,
             system,
-            constrained,
+            constraints,
             good_steps_since_cut: 0,
             f_ext0: vec![0.0; n],
             f_int0: vec![0.0; n],
@@ -285,6 +292,7 @@ impl Stepper {
             model_size: 0.0,
             delassus_cache: None,
             reactions: vec![0.0; n],
+            workspace: Workspace::default(),
         };
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for p in &s.disc.reference {
@@ -308,27 +316,12 @@ impl Stepper {
                 ]
             })
             .collect();
-        s.apply_dirichlet_to_state();
+        s.constraints.impose(&s.disc.reference, 0.0, &mut s.state.u);
         s.f_ext0 = s.external_force(0.0);
         let a = s.disc.assemble(&s.state.u, false);
         s.f_int0 = a.force;
         s.last_internal = a.energy;
         Ok(s)
-    }
-
-    fn apply_dirichlet_to_state(&mut self) {
-        let u = &mut self.state.u;
-        for d in &self.problem.dirichlet {
-            for &node in &d.nodes {
-                let x = self.disc.reference[node];
-                let ud = d.displacement(x, 0.0);
-                for k in 0..3 {
-                    if d.components[k] {
-                        u[3 * node + k] = ud[k];
-                    }
-                }
-            }
-        }
     }
 
     /// Loads and gravity at time `t` [N].
@@ -427,7 +420,9 @@ impl Stepper {
     /// Kinetic energy ½ vᵀMv of a velocity field [J].
     pub fn kinetic_energy(&self, v: &[f64]) -> f64 {
         let mut mv = vec![0.0; v.len()];
-        self.disc.pattern.symmetric_matvec(&self.mass, v, &mut mv);
+        self.disc
+            .pattern
+            .symmetric_matvec(&self.inertia.mass, v, &mut mv);
         0.5 * v.iter().zip(&mv).map(|(a, b)| a * b).sum::<f64>()
     }
 
@@ -500,19 +495,31 @@ impl Stepper {
     }
 
     fn commit_contact(&mut self, points: &[ContactPoint], sols: &[PointSolution]) {
-        for nodes in &mut self.contact {
+        let bond0 = self.bonds_at_start(points);
+        // Nodes that are not candidates of this step lose their bond (β = 0); what they
+        // dissipated stays.
+        for (nodes, pair) in self.contact.iter_mut().zip(&self.problem.contacts) {
             for n in nodes.iter_mut() {
+                let damage = match &pair.law.adhesion {
+                    Some(a) => accumulated_damage(n.damage, n.beta, 0.0, a),
+                    None => n.damage,
+                };
                 *n = NodeContact {
                     gap: f64::NAN,
+                    damage,
                     ..Default::default()
                 };
             }
         }
-        for (pt, sol) in points.iter().zip(sols) {
+        for ((pt, sol), b0) in points.iter().zip(sols).zip(bond0) {
             let f = &pt.frame;
             let r = sol.r();
             let global = |v: [f64; 3]| -> [f64; 3] {
                 std::array::from_fn(|k| v[0] * f[0][k] + v[1] * f[1][k] + v[2] * f[2][k])
+            };
+            let damage = match &self.problem.contacts[pt.pair].law.adhesion {
+                Some(a) => accumulated_damage(b0.damage, b0.beta, sol.beta, a),
+                None => b0.damage,
             };
             self.contact[pt.pair][pt.local] = NodeContact {
                 beta: sol.beta,
@@ -528,6 +535,7 @@ impl Stepper {
                     ContactState::Slide => 3,
                 },
                 tangent_axes: [f[0], f[1]],
+                damage,
             };
         }
     }
@@ -543,6 +551,7 @@ impl Stepper {
                 BondState {
                     beta: c.beta,
                     ut: [dot(c.ut, f[0]), dot(c.ut, f[1])],
+                    damage: c.damage,
                 }
             })
             .collect()
@@ -585,18 +594,118 @@ impl Stepper {
             .collect()
     }
 
-    /// One Newton solve over [t, t+dt]; Err with the reason on failure.
+    /// One Newton solve over [t, t+dt]; Err with the reason on failure. The stages follow
+    /// docs/model.md §3: detect, predict, then per iteration assemble, evaluate the contact
+    /// law, check convergence, factorise K̄ and solve the correction, solve the contact
+    /// problem, update.
     fn attempt(&mut self, dt: f64) -> Result<Attempt, String> {
         self.disc.begin_step(dt);
-        let ts = self.problem.time.clone();
-        let (theta, xi, qs) = (ts.theta, ts.xi, ts.quasi_static);
-        let newton_contact = ts.contact_solver == ContactSolver::Newton;
-        let t1 = self.state.t + dt;
-        let n = self.disc.num_dofs();
+        let (ts, t1) = (&self.problem.time, self.state.t + dt);
         let f_ext1 = self.external_force(t1);
         let mut timings = PhaseTimes::default();
-        let clock = std::time::Instant::now();
-        let points = if self.problem.contacts.is_empty() {
+        let clock = Instant::now();
+        let candidates = self.detect_contact(t1);
+        let laws = self.problem.contacts.iter().map(|c| c.law).collect();
+        let (contact, lambda) = StepContact::new(
+            candidates,
+            laws,
+            dt,
+            &self.disc.reference,
+            &self.constraints,
+        );
+        let mut coupling = couple(contact, lambda, &mut self.system, &mut self.delassus_cache)?;
+        timings.delassus += clock.elapsed().as_secs_f64();
+        let step = ThetaStep::new(
+            &Scheme::of(ts),
+            dt,
+            (&self.state.u, &self.state.v),
+            (&self.f_ext0, &self.f_int0),
+            f_ext1,
+            &self.inertia,
+            &self.disc.pattern,
+        );
+        let ws = &mut self.workspace;
+        let mut u = step.predict(ws);
+        self.constraints.impose(&self.disc.reference, t1, &mut u);
+        let (mut negligible, mut last_rel, mut contact_residual) = (false, f64::NAN, 0.0);
+        for iter in 1..=ts.max_newton {
+            let asm = assemble(&self.disc, &u, iter, &mut timings)?;
+            let balance = step.balance(&u, &asm.force, asm.energy, ws);
+            if iter == 1 {
+                coupling
+                    .step_contact()
+                    .set_augmentation(|| step.matrix_diagonal(&asm.tangent));
+            }
+            let it = Iterate::new(iter, &ws.g, balance.potential);
+            if let Evaluated::Backtracked = coupling.evaluate(&it, &mut u, &mut timings) {
+                continue;
+            }
+            let scale = balance.scale.max(coupling.step_contact().bond_strength);
+            let check = check_balance(
+                &mut ws.g,
+                coupling.contact_force(),
+                &self.constraints,
+                scale,
+                iter,
+            )?;
+            last_rel = check.relative;
+            contact_residual = coupling.contact_residual(check.scale);
+            let contact_solved = coupling.step_contact().is_empty()
+                || (iter > 1 && contact_residual <= ts.contact_tol);
+            if contact_solved && check.converged(ts.newton_tol, negligible) {
+                return Ok(finish(
+                    &step,
+                    u,
+                    asm,
+                    check,
+                    coupling,
+                    contact_residual,
+                    &ws.v1,
+                    timings,
+                ));
+            }
+            if iter == ts.max_newton {
+                break;
+            }
+            let mut du = newton_correction(
+                &mut self.system,
+                &step,
+                &asm.tangent,
+                coupling.as_ref(),
+                &ws.g,
+                iter,
+                &mut timings,
+            )?;
+            let it = Iterate::new(iter, &ws.g, balance.potential);
+            coupling.correct(
+                &it,
+                &u,
+                &mut du,
+                check.norm,
+                check.scale,
+                &mut self.system,
+                &mut timings,
+            )?;
+            for (ui, di) in u.iter_mut().zip(&du) {
+                *ui += di;
+            }
+            // The floor (1e-6 of the model size) covers steps in which nothing moves.
+            negligible =
+                norm(&du) <= ts.newton_tol * step.increment(&u).max(1e-6 * self.model_size);
+        }
+        coupling.abandon();
+        Err(format!(
+            "Newton did not converge in {} iterations (residual {last_rel:.2e}, contact residual {contact_residual:.2e})",
+            ts.max_newton
+        ))
+    }
+
+    /// Stage *detect*: the contact candidates over [t, t1] with their committed bond state,
+    /// the force their bonds can carry, ‖(A_α √(C w))_α‖ [N] (the force scale of an
+    /// interface that holds, or snaps into, contact without load), and, for the Newton
+    /// contact solve, the multipliers it starts from.
+    fn detect_contact(&self, t1: f64) -> Candidates {
+        let mut points = if self.problem.contacts.is_empty() {
             Vec::new()
         } else {
             detect(
@@ -607,9 +716,7 @@ impl Stepper {
                 t1,
             )
         };
-        let bond0 = self.bonds_at_start(&points);
-        // Force the adhesive bonds of the candidates can carry, ‖(A_α √(C w))_α‖ [N]: the force
-        // scale of an interface that holds (or snaps into) contact without load.
+        align_frames(&mut points, &self.problem.contacts);
         let bond_strength = points
             .iter()
             .map(|pt| {
@@ -619,534 +726,164 @@ impl Stepper {
             })
             .sum::<f64>()
             .sqrt();
-        let laws: Vec<_> = self.problem.contacts.iter().map(|c| c.law).collect();
-        let mut r_contact: Vec<[f64; 3]> = vec![[0.0; 3]; points.len()];
-        let mut r_dry: Vec<[f64; 3]> = vec![[0.0; 3]; points.len()];
-        let mut solutions: Vec<PointSolution> = Vec::new();
-        let mut sweeps = 0;
-        let mut contact_force = vec![0.0; n];
-        // Newton contact solve: multipliers (warm-started from the committed dry forces),
-        // augmentation parameters (set at the first iteration) and the law at the iterate.
-        let mut lambda = self.multipliers_at_start(&points);
-        let mut rho: Vec<f64> = Vec::new();
-        let mut evals: Vec<AugmentedPoint> = Vec::new();
-        let mut contact_residual = 0.0;
-        if newton_contact && !points.is_empty() {
-            self.system
-                .ensure_couplings(&newton::couplings(&points))
-                .map_err(|e| e.to_string())?;
+        Candidates {
+            multipliers: (self.problem.time.contact_solver == ContactSolver::Newton)
+                .then(|| self.multipliers_at_start(&points)),
+            bond0: self.bonds_at_start(&points),
+            points,
+            bond_strength,
         }
-        timings.delassus += clock.elapsed().as_secs_f64();
-        let u0 = &self.state.u;
-        let v0 = &self.state.v;
-        // Predictor: constant velocity for dynamics, last state for quasi-static.
-        let mut u: Vec<f64> = if qs {
-            u0.clone()
-        } else {
-            (0..n).map(|i| u0[i] + dt * v0[i]).collect()
-        };
-        for d in &self.problem.dirichlet {
-            for &node in &d.nodes {
-                let ud = d.displacement(self.disc.reference[node], t1);
-                for k in 0..3 {
-                    if d.components[k] {
-                        u[3 * node + k] = ud[k];
-                    }
-                }
-            }
-        }
-        // Terms fixed over the step: (1−ξ)(F_ext⁰ − F_int⁰ − A v₀).
-        let mut fixed = vec![0.0; n];
-        if !qs {
-            let mut av0 = vec![0.0; n];
-            if let Some(a) = &self.damping {
-                self.disc.pattern.symmetric_matvec(a, v0, &mut av0);
-            }
-            for i in 0..n {
-                fixed[i] = (1.0 - xi) * (self.f_ext0[i] - self.f_int0[i] - av0[i]);
-            }
-        }
-        let c_mass = if qs { 0.0 } else { 1.0 / (theta * dt * dt) };
-        let c_damp = if qs { 0.0 } else { xi / (theta * dt) };
-        let c_stiff = if qs { 1.0 } else { xi };
-        let mut g = vec![0.0; n];
-        let mut tmp = vec![0.0; n];
-        let mut last_correction_negligible = false;
-        let mut last_rel = f64::NAN;
-        let mut line_search: Option<LineSearch> = None;
-        let mut contact_energy = 0.0;
-        let mut prev_du_norm: Option<f64> = None;
-        let mut delassus_builds = 0usize;
-        // Whether this attempt has built or checked the Delassus operator in use.
-        let mut delassus_checked = false;
-        let delassus_key = if newton_contact {
-            Vec::new()
-        } else {
-            delassus_key(&points, dt)
-        };
-        for iter in 1..=ts.max_newton {
-            let clock = std::time::Instant::now();
-            let asm = self.disc.assemble(&u, true);
-            timings.assembly += clock.elapsed().as_secs_f64();
-            if !(asm.min_j > 0.0) || !asm.energy.is_finite() {
-                return Err(format!(
-                    "an element inverted (min det F = {:.3e}) at Newton iteration {iter}",
-                    asm.min_j
-                ));
-            }
-            let v1: Vec<f64> = (0..n)
-                .map(|i| (u[i] - u0[i]) / (theta * dt) - (1.0 - theta) / theta * v0[i])
-                .collect();
-            // Residual.
-            for i in 0..n {
-                g[i] = c_stiff * (asm.force[i] - f_ext1[i]) - fixed[i];
-            }
-            let mut scale = norm(&asm.force).max(norm(&f_ext1)).max(norm(&fixed));
-            // The step's potential Π(u), whose gradient is g (for the line search): strain
-            // energy, loads, and the inertia and damping terms of the θ-method.
-            let mut potential = c_stiff * asm.energy
-                - (0..n)
-                    .map(|i| (c_stiff * f_ext1[i] + fixed[i]) * u[i])
-                    .sum::<f64>();
-            if !qs {
-                tmp.iter_mut().for_each(|x| *x = 0.0);
-                let acc: Vec<f64> = (0..n)
-                    .map(|i| (u[i] - u0[i] - dt * v0[i]) * c_mass)
-                    .collect();
-                self.disc
-                    .pattern
-                    .symmetric_matvec(&self.mass, &acc, &mut tmp);
-                scale = scale.max(norm(&tmp));
-                for i in 0..n {
-                    g[i] += tmp[i];
-                    potential += 0.5 * (u[i] - u0[i] - dt * v0[i]) * tmp[i];
-                }
-                if let Some(a) = &self.damping {
-                    tmp.iter_mut().for_each(|x| *x = 0.0);
-                    self.disc.pattern.symmetric_matvec(a, &v1, &mut tmp);
-                    for i in 0..n {
-                        g[i] += xi * tmp[i];
-                    }
-                    // ξ A v₁ is the gradient of ξ[(u − u₀)ᵀA(u − u₀)/(2θΔt) − (1−θ)/θ v₀ᵀA(u − u₀)].
-                    let half: Vec<f64> = (0..n)
-                        .map(|i| {
-                            0.5 * (u[i] - u0[i]) / (theta * dt) - (1.0 - theta) / theta * v0[i]
-                        })
-                        .collect();
-                    tmp.iter_mut().for_each(|x| *x = 0.0);
-                    self.disc.pattern.symmetric_matvec(a, &half, &mut tmp);
-                    potential += xi * (0..n).map(|i| (u[i] - u0[i]) * tmp[i]).sum::<f64>();
-                }
-            }
-            let mut natural_map = 0.0;
-            if iter == 1 && !points.is_empty() {
-                rho = self.augmentation(&points, &asm.tangent, c_stiff, c_mass, c_damp);
-            }
-            if newton_contact && !points.is_empty() {
-                let clock = std::time::Instant::now();
-                // The contact law at u with the multipliers of the last Newton step.
-                (evals, contact_force) =
-                    self.contact_law_at(&points, &laws, &bond0, dt, &rho, &lambda, &u);
-                let merit = norm_free(&g, &contact_force, &self.constrained);
-                let total: f64 = potential + evals.iter().map(|e| e.energy).sum::<f64>();
-                // Line search on that step: with the multipliers fixed, the Newton step
-                // solves for a stationary point of Π(u) + Σ φ_α(x_α(u)), and its matrix is
-                // positive definite, so the step is a descent direction. A step that does not
-                // lower that potential by the Armijo factor is halved (a full step can
-                // overshoot where points open or close, and then cycle).
-                if let Some(ls) = &mut line_search {
-                    let same_cases = evals
-                        .iter()
-                        .zip(&ls.cases)
-                        .all(|(e, c)| e.solution.state == *c);
-                    // Near the solution the potential's decrease drowns in its round-off:
-                    // a step that reduces ‖G − Hᵀr‖ is accepted as well.
-                    let descent = total <= ls.energy0 + 1e-4 * ls.alpha * ls.slope
-                        || merit <= (1.0 - 1e-4 * ls.alpha) * ls.merit0;
-                    if (same_cases || iter > CYCLING_ITERATIONS)
-                        && !descent
-                        && ls.alpha > MIN_STEP_LENGTH
-                    {
-                        ls.alpha *= 0.5;
-                        for i in 0..n {
-                            u[i] = ls.u0[i] + ls.alpha * ls.du[i];
-                        }
-                        timings.contact_solve += clock.elapsed().as_secs_f64();
-                        continue;
-                    }
-                }
-                line_search = None;
-                contact_energy = total;
-                let contact_defect = newton::defect_norm(&evals);
-                // Multiplier update λ ← P_K(λ − ρ x̂(u)) once the equilibrium with the current
-                // multipliers is reached to a tenth of the change the update would make.
-                if iter > 1 && merit <= 0.1 * contact_defect {
-                    for (l, e) in lambda.iter_mut().zip(&evals) {
-                        *l = e.solution.r_dry;
-                    }
-                    sweeps += 1;
-                    (evals, contact_force) =
-                        self.contact_law_at(&points, &laws, &bond0, dt, &rho, &lambda, &u);
-                    contact_energy = potential + evals.iter().map(|e| e.energy).sum::<f64>();
-                }
-                let solved: Vec<PointSolution> = evals.iter().map(|e| e.solution).collect();
-                natural_map = natural_map_residual(&laws, &points, &rho, &solved);
-                timings.contact_solve += clock.elapsed().as_secs_f64();
-            }
-            // g is G(u) without contact (what the Newton correction solves against); the
-            // convergence check uses G(u) − Hᵀr.
-            let mut g_check: Vec<f64> = (0..n).map(|i| g[i] - contact_force[i]).collect();
-            let reactions: Vec<f64> = (0..n)
-                .map(|i| if self.constrained[i] { g_check[i] } else { 0.0 })
-                .collect();
-            for i in 0..n {
-                if self.constrained[i] {
-                    g[i] = 0.0;
-                    g_check[i] = 0.0;
-                }
-            }
-            scale = scale.max(norm(&contact_force)).max(bond_strength);
-            let gnorm = norm(&g_check);
-            if !gnorm.is_finite() {
-                return Err(format!(
-                    "the residual is not finite at Newton iteration {iter}"
-                ));
-            }
-            // Force scale of the current iterate (internal, external, inertial forces and
-            // support reactions), so that a large out-of-balance force of an early iterate
-            // does not make later residuals look small.
-            let scale = scale.max(norm(&reactions)).max(f64::MIN_POSITIVE);
-            let rel = gnorm / scale;
-            last_rel = rel;
-            if newton_contact {
-                contact_residual = natural_map / scale;
-            }
-            // Converged when the residual is small against the forces, or when the last
-            // correction was negligible against the step's displacement increment (the
-            // residual can sit at its round-off floor when every force is small, e.g. a
-            // vibrating body passing through its rest position), and the contact forces
-            // satisfy the contact law. With contact candidates, the contact problem must have
-            // been solved at least once.
-            let contact_solved =
-                points.is_empty() || (iter > 1 && contact_residual <= ts.contact_tol);
-            if contact_solved
-                && (rel <= ts.newton_tol || gnorm == 0.0 || last_correction_negligible)
-            {
-                let du: Vec<f64> = (0..n).map(|i| u[i] - u0[i]).collect();
-                let mut work = 0.0;
-                for i in 0..n {
-                    let f_applied = if qs {
-                        f_ext1[i]
-                    } else {
-                        (1.0 - xi) * self.f_ext0[i] + xi * f_ext1[i]
-                    };
-                    work += du[i] * (f_applied + reactions[i] + contact_force[i]);
-                }
-                if newton_contact {
-                    solutions = evals.iter().map(|e| e.solution).collect();
-                }
-                return Ok(Attempt {
-                    v: if qs {
-                        du.iter().map(|d| d / dt).collect()
-                    } else {
-                        v1
-                    },
-                    u,
-                    f_ext1,
-                    f_int1: asm.force,
-                    iterations: iter - 1,
-                    residual: rel,
-                    internal: asm.energy,
-                    work,
-                    points,
-                    solutions,
-                    sweeps,
-                    contact_residual,
-                    delassus_builds,
-                    timings,
-                    reactions,
-                });
-            }
-            if iter == ts.max_newton {
-                break;
-            }
-            let clock = std::time::Instant::now();
-            // K̄ = c_stiff K + c_damp A + c_mass M (+ the contact law's stiffness).
-            let mut terms: Vec<(f64, &[f64])> = vec![(c_stiff, &asm.tangent), (c_mass, &self.mass)];
-            if let Some(a) = &self.damping {
-                terms.push((c_damp, a));
-            }
-            self.system.set_from_base(&terms);
-            if newton_contact && !points.is_empty() {
-                let stiffness: Vec<_> = evals.iter().map(|e| e.stiffness).collect();
-                let pattern = self.system.pattern().clone();
-                newton::add_contact_tangent(&points, &stiffness, &pattern, &mut self.system.values);
-            }
-            self.system
-                .factorise()
-                .map_err(|e| format!("{e} (Newton iteration {iter})"))?;
-            // Newton correction against the residual with the current contact forces Hᵀr.
-            // Gauss-Seidel: the contact solve then corrects it by K̄⁻¹Hᵀ(r − r_prev). At a
-            // converged iterate r = r_prev and G(u) = Hᵀr whatever W was used, so W may be
-            // reused from an earlier iteration or step (it then only slows the convergence).
-            let mut du: Vec<f64> = (0..n).map(|i| contact_force[i] - g[i]).collect();
-            self.system.solve_in_place(&mut du);
-            timings.factorisation += clock.elapsed().as_secs_f64();
-            if !newton_contact && !points.is_empty() {
-                let clock = std::time::Instant::now();
-                let du_norm = norm(&du);
-                let slow = prev_du_norm.is_some_and(|p| du_norm > DELASSUS_REUSE_RATIO * p);
-                prev_du_norm = Some(du_norm);
-                let mut reusable =
-                    matches!(&self.delassus_cache, Some((k, _)) if *k == delassus_key);
-                // A W from an earlier step, or a slow convergence, is checked before reuse.
-                // Slow convergence comes from the nonsmooth contact laws as often as from a
-                // stale W: probe three columns of the current W (at the point carrying the
-                // largest force; the first point while r_contact is still zero) and rebuild
-                // only when they differ from the cached ones.
-                if reusable && (slow || !delassus_checked) {
-                    delassus_checked = true;
-                    let probe = r_contact
-                        .iter()
-                        .enumerate()
-                        .max_by(|a, b| norm(a.1).total_cmp(&norm(b.1)))
-                        .map(|(p, _)| p)
-                        .unwrap_or(0);
-                    let cached = &self.delassus_cache.as_ref().expect("checked").1;
-                    reusable = cached.probed_change(
-                        &points,
-                        probe,
-                        self.system.cholesky(),
-                        &self.constrained,
-                    ) <= DELASSUS_STALE_TOL;
-                }
-                if !reusable {
-                    let del = delassus(&points, self.system.cholesky(), &self.constrained);
-                    self.delassus_cache = Some((delassus_key.clone(), del));
-                    delassus_builds += 1;
-                    delassus_checked = true;
-                }
-                let del = &self.delassus_cache.as_ref().expect("built above").1;
-                let m = del.m;
-                // Reduced contact system: x = x(u) + H Δu_free + W (r − r_prev).
-                let x_free: Vec<[f64; 3]> = points
-                    .iter()
-                    .enumerate()
-                    .map(|(p, pt)| {
-                        let x = pt.local_x(&self.disc.reference, &u);
-                        let h = pt.apply_h(&du);
-                        let mut xf = [x[0] + h[0], x[1] + h[1], x[2] + h[2]];
-                        for (a, xa) in xf.iter_mut().enumerate() {
-                            let row = &del.w[(3 * p + a) * m..(3 * p + a + 1) * m];
-                            for (q, rq) in r_contact.iter().enumerate() {
-                                *xa -= row[3 * q] * rq[0]
-                                    + row[3 * q + 1] * rq[1]
-                                    + row[3 * q + 2] * rq[2];
-                            }
-                        }
-                        xf
-                    })
-                    .collect();
-                timings.delassus += clock.elapsed().as_secs_f64();
-                let clock = std::time::Instant::now();
-                let sol = gauss_seidel(
-                    &points, &laws, &bond0, dt, del, &x_free, &r_contact, &r_dry, 1e-10, 5000,
-                );
-                sweeps += sol.sweeps;
-                timings.contact_solve += clock.elapsed().as_secs_f64();
-                if !sol.converged {
-                    self.delassus_cache = None;
-                    return Err(format!("the contact solve did not settle in {} Gauss-Seidel sweeps (Newton iteration {iter})", sol.sweeps));
-                }
-                let clock = std::time::Instant::now();
-                let mut new_force = vec![0.0; n];
-                for (p, ps) in sol.points.iter().enumerate() {
-                    let r = ps.r();
-                    r_contact[p] = r;
-                    r_dry[p] = ps.r_dry;
-                    points[p].add_ht(r, &mut new_force);
-                }
-                for i in 0..n {
-                    if self.constrained[i] {
-                        new_force[i] = 0.0;
-                    }
-                }
-                let mut dc: Vec<f64> = (0..n).map(|i| new_force[i] - contact_force[i]).collect();
-                self.system.solve_in_place(&mut dc);
-                for i in 0..n {
-                    du[i] += dc[i];
-                }
-                contact_force = new_force;
-                solutions = sol.points;
-                contact_residual = natural_map_residual(&laws, &points, &rho, &solutions) / scale;
-                timings.delassus += clock.elapsed().as_secs_f64();
-            }
-            if newton_contact && !points.is_empty() {
-                line_search = Some(LineSearch {
-                    cases: evals.iter().map(|e| e.solution.state).collect(),
-                    slope: (0..n)
-                        .filter(|&i| !self.constrained[i])
-                        .map(|i| (g[i] - contact_force[i]) * du[i])
-                        .sum(),
-                    u0: u.clone(),
-                    du: du.clone(),
-                    alpha: 1.0,
-                    energy0: contact_energy,
-                    merit0: gnorm,
-                });
-            }
-            for i in 0..n {
-                u[i] += du[i];
-            }
-            let increment = (0..n).map(|i| (u[i] - u0[i]).powi(2)).sum::<f64>().sqrt();
-            // The floor (1e-6 of the model size) covers steps in which nothing moves.
-            last_correction_negligible =
-                norm(&du) <= ts.newton_tol * increment.max(1e-6 * self.model_size);
-        }
-        self.delassus_cache = None;
-        Err(format!(
-            "Newton did not converge in {} iterations (residual {:.2e}, contact residual {:.2e})",
-            ts.max_newton, last_rel, contact_residual
-        ))
-    }
-
-    /// The contact law of every point at displacement `u` with multipliers `lambda`, and the
-    /// contact force Hᵀr on the free unknowns.
-    #[allow(clippy::too_many_arguments)]
-    fn contact_law_at(
-        &self,
-        points: &[ContactPoint],
-        laws: &[crate::contact::InterfaceLaw],
-        bond0: &[BondState],
-        dt: f64,
-        rho: &[f64],
-        lambda: &[[f64; 3]],
-        u: &[f64],
-    ) -> (Vec<AugmentedPoint>, Vec<f64>) {
-        let evals: Vec<AugmentedPoint> = points
-            .iter()
-            .enumerate()
-            .map(|(p, pt)| {
-                let x = pt.local_x(&self.disc.reference, u);
-                augmented_point(&laws[pt.pair], bond0[p], dt, pt.area, rho[p], lambda[p], x)
-            })
-            .collect();
-        let mut force = vec![0.0; u.len()];
-        for (pt, ev) in points.iter().zip(&evals) {
-            pt.add_ht(ev.solution.r(), &mut force);
-        }
-        for (f, &fixed) in force.iter_mut().zip(&self.constrained) {
-            if fixed {
-                *f = 0.0;
-            }
-        }
-        (evals, force)
-    }
-
-    /// Augmentation parameter ρ_α [N/m] of each point: [`newton::RHO_FACTOR`] times the
-    /// stiffness K̄ = c_stiff K + c_mass M + c_damp A shows there.
-    fn augmentation(
-        &self,
-        points: &[ContactPoint],
-        tangent: &[f64],
-        c_stiff: f64,
-        c_mass: f64,
-        c_damp: f64,
-    ) -> Vec<f64> {
-        let pattern = &self.disc.pattern;
-        let diagonal: Vec<f64> = (0..pattern.dim())
-            .map(|d| {
-                let q = pattern.diagonal_position(d);
-                let a = self.damping.as_ref().map_or(0.0, |a| a[q]);
-                c_stiff * tangent[q] + c_mass * self.mass[q] + c_damp * a
-            })
-            .collect();
-        points
-            .iter()
-            .map(|pt| {
-                newton::point_stiffness(pt, &diagonal, &self.constrained)
-                    .map_or(1.0, |k| newton::RHO_FACTOR * k)
-            })
-            .collect()
     }
 }
 
-/// Natural-map residual ‖(r̄_α − P_K(r̄_α − ρ_α x̂_α))_α‖ [N] of the bi-potential condition,
-/// at each solution's own x, with the ρ_α of the Newton solver: the same measure for both
-/// solvers.
-fn natural_map_residual(
-    laws: &[crate::contact::InterfaceLaw],
-    points: &[ContactPoint],
-    rho: &[f64],
-    solutions: &[PointSolution],
-) -> f64 {
-    points
+/// The contact solve of the step: the Newton solve when `lambda` (its starting multipliers)
+/// is given, Gauss-Seidel on the Delassus operator otherwise.
+fn couple<'a>(
+    contact: StepContact<'a>,
+    lambda: Option<Vec<[f64; 3]>>,
+    system: &mut SystemMatrix,
+    delassus_cache: &'a mut DelassusCache,
+) -> Result<Box<dyn ContactCoupling<'a> + 'a>, String> {
+    Ok(match lambda {
+        Some(lambda) => Box::new(NewtonCoupling::new(contact, lambda, system)?),
+        None => Box::new(DelassusCoupling::new(contact, delassus_cache)),
+    })
+}
+
+/// Stage *factorise and solve*: K̄ = c_stiff K + c_damp A + c_mass M (+ the contact law's
+/// stiffness) and the correction against the residual with the current contact forces Hᵀr.
+/// The Gauss-Seidel solve then adds K̄⁻¹Hᵀ(r − r_prev): at a converged iterate r = r_prev and
+/// G(u) = Hᵀr whatever W was used, so W may be reused from an earlier iteration or step (it
+/// then only slows the convergence).
+fn newton_correction(
+    system: &mut SystemMatrix,
+    step: &ThetaStep,
+    tangent: &[f64],
+    coupling: &dyn ContactCoupling<'_>,
+    g: &[f64],
+    iter: usize,
+    timings: &mut PhaseTimes,
+) -> Result<Vec<f64>, String> {
+    let clock = Instant::now();
+    system.set_from_base(&step.matrix_terms(tangent));
+    coupling.add_tangent(system);
+    system
+        .factorise()
+        .map_err(|e| format!("{e} (Newton iteration {iter})"))?;
+    let mut du: Vec<f64> = coupling
+        .contact_force()
         .iter()
-        .zip(rho)
-        .zip(solutions)
-        .map(|((pt, &rho), sol)| {
-            let p = bipotential_projection(laws[pt.pair].mu, rho, sol.r_dry, sol.x);
-            (0..3).map(|k| (sol.r_dry[k] - p[k]).powi(2)).sum::<f64>()
-        })
-        .sum::<f64>()
-        .sqrt()
+        .zip(g)
+        .map(|(r, g)| r - g)
+        .collect();
+    system.solve_in_place(&mut du);
+    timings.factorisation += clock.elapsed().as_secs_f64();
+    Ok(du)
 }
 
-/// A Newton step under line search: from `u0` along `du`, at step length `alpha`, against the
-/// potential `energy0` at `u0` and its slope along `du`.
-struct LineSearch {
-    cases: Vec<ContactState>,
-    u0: Vec<f64>,
-    du: Vec<f64>,
-    alpha: f64,
-    energy0: f64,
-    slope: f64,
-    merit0: f64,
-}
-
-/// Newton iterations after which a step that changes the contact cases is line-searched too.
-const CYCLING_ITERATIONS: usize = 0;
-
-/// Shortest step length the line search tries before it takes the step anyway.
-const MIN_STEP_LENGTH: f64 = 1.0 / 64.0;
-
-/// ‖g − f‖ over the free unknowns.
-fn norm_free(g: &[f64], f: &[f64], constrained: &[bool]) -> f64 {
-    g.iter()
-        .zip(f)
-        .zip(constrained)
-        .filter(|(_, &c)| !c)
-        .map(|((a, b), _)| (a - b) * (a - b))
-        .sum::<f64>()
-        .sqrt()
-}
-
-/// A Newton correction larger than this fraction of the previous one means the contact
-/// coupling is converging slowly: W is rebuilt with the current factorisation.
-const DELASSUS_REUSE_RATIO: f64 = 0.5;
-
-/// Relative change of probed columns of W above which the cached W is rebuilt.
-const DELASSUS_STALE_TOL: f64 = 1e-4;
-
-/// What W depends on besides K̄: the contact points (pair, node, frame, master weights) and
-/// Δt (K̄ = ξK + M/(θΔt²) + ...). Compared bit for bit.
-fn delassus_key(points: &[ContactPoint], dt: f64) -> Vec<u64> {
-    let mut key = Vec::with_capacity(points.len() * 12 + 1);
-    key.push(dt.to_bits());
-    for p in points {
-        key.push(p.pair as u64);
-        key.push(p.slave as u64);
-        for row in &p.frame {
-            key.extend(row.iter().map(|x| x.to_bits()));
-        }
-        for &(m, w) in &p.master {
-            key.push(m as u64);
-            key.push(w.to_bits());
-        }
+/// Stage *commit* (what the step hands back): the converged iterate `u` with its end
+/// velocity, work, forces and contact solution.
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    step: &ThetaStep,
+    u: Vec<f64>,
+    asm: Assembled,
+    check: Check,
+    coupling: Box<dyn ContactCoupling<'_> + '_>,
+    contact_residual: f64,
+    v1: &[f64],
+    timings: PhaseTimes,
+) -> Attempt {
+    Attempt {
+        work: step.work(&u, &check.reactions, coupling.contact_force()),
+        v: step.end_velocity(&u, v1),
+        f_ext1: step.f_ext1.clone(),
+        u,
+        f_int1: asm.force,
+        iterations: check.iter - 1,
+        residual: check.relative,
+        internal: asm.energy,
+        solutions: coupling.solutions(),
+        sweeps: coupling.sweeps(),
+        contact_residual,
+        delassus_builds: coupling.delassus_builds(),
+        timings,
+        reactions: check.reactions,
+        points: coupling.into_points(),
     }
-    key
 }
 
-fn norm(x: &[f64]) -> f64 {
-    x.iter().map(|a| a * a).sum::<f64>().sqrt()
+/// Stage *assemble*: internal force, strain energy and tangent at `u`; an inverted element
+/// fails the attempt.
+fn assemble(
+    disc: &Discretisation,
+    u: &[f64],
+    iter: usize,
+    timings: &mut PhaseTimes,
+) -> Result<Assembled, String> {
+    let clock = Instant::now();
+    let asm = disc.assemble(u, true);
+    timings.assembly += clock.elapsed().as_secs_f64();
+    if !(asm.min_j > 0.0) || !asm.energy.is_finite() {
+        return Err(format!(
+            "an element inverted (min det F = {:.3e}) at Newton iteration {iter}",
+            asm.min_j
+        ));
+    }
+    Ok(asm)
+}
+
+/// The out-of-balance force G − Hᵀr of an iterate, measured.
+struct Check {
+    /// Newton iteration (1-based).
+    iter: usize,
+    /// ‖G − Hᵀr‖ on the free unknowns [N].
+    norm: f64,
+    /// The force scale it is measured against [N].
+    scale: f64,
+    /// norm / scale.
+    relative: f64,
+    /// Support reactions [N] (zero on free unknowns).
+    reactions: Vec<f64>,
+}
+
+impl Check {
+    /// Converged when the residual is small against the forces, or when the last correction
+    /// was `negligible` against the step's displacement increment (the residual can sit at
+    /// its round-off floor when every force is small, e.g. a vibrating body passing through
+    /// its rest position).
+    fn converged(&self, tol: f64, negligible: bool) -> bool {
+        self.relative <= tol || self.norm == 0.0 || negligible
+    }
+}
+
+/// Stage *check*: G − Hᵀr against the iterate's force scale (internal, external, inertial,
+/// contact forces and support reactions, so that a large out-of-balance force of an early
+/// iterate does not make later residuals look small). Zeroes `g` on the prescribed unknowns.
+fn check_balance(
+    g: &mut [f64],
+    contact_force: &[f64],
+    constraints: &Constraints,
+    scale: f64,
+    iter: usize,
+) -> Result<Check, String> {
+    let mut out_of_balance: Vec<f64> = g.iter().zip(contact_force).map(|(a, b)| a - b).collect();
+    let reactions = constraints.reactions(&out_of_balance);
+    constraints.zero_fixed(g);
+    constraints.zero_fixed(&mut out_of_balance);
+    let scale = scale.max(norm(contact_force));
+    let residual = norm(&out_of_balance);
+    if !residual.is_finite() {
+        return Err(format!(
+            "the residual is not finite at Newton iteration {iter}"
+        ));
+    }
+    let scale = scale.max(norm(&reactions)).max(f64::MIN_POSITIVE);
+    Ok(Check {
+        iter,
+        norm: residual,
+        scale,
+        relative: residual / scale,
+        reactions,
+    })
 }

@@ -266,6 +266,7 @@ fn indent_with(
             law: InterfaceLaw {
                 mu: 0.0,
                 adhesion: None,
+                anisotropy: None,
             },
             // The no-penetration check below covers every surface node, candidate or not.
             detection_distance: detection,

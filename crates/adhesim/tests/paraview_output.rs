@@ -62,7 +62,7 @@ frame_interval = 0.25
 
 const BODY_POINT: [&str; 3] = ["u", "v", "node_id"];
 const BODY_CELL: [&str; 4] = ["cauchy", "von_mises", "J", "body_id"];
-const CONTACT_POINT: [&str; 18] = [
+const CONTACT_POINT: [&str; 19] = [
     "node_id",
     "area",
     "beta",
@@ -81,6 +81,7 @@ const CONTACT_POINT: [&str; 18] = [
     "slip",
     "ut",
     "state",
+    "damage",
 ];
 const CONTACT_CELL: [&str; 2] = ["pair_id", "body_id"];
 

@@ -118,7 +118,11 @@ fn nsgs_dense(p: &ReducedProblem, del: &Delassus, tol: f64, max_iter: usize) -> 
         .collect();
     let laws: Vec<InterfaceLaw> =
         p.mu.iter()
-            .map(|&mu| InterfaceLaw { mu, adhesion: None })
+            .map(|&mu| InterfaceLaw {
+                mu,
+                adhesion: None,
+                anisotropy: None,
+            })
             .collect();
     let bond0 = vec![BondState::default(); n];
     let mut r = vec![[0.0; 3]; n];

@@ -1,4 +1,4 @@
-//! The local interface law at one contact point (model.md §5–§6): dry Signorini–Coulomb contact
+//! The local interface law at one contact point (docs/model.md §5–§6): dry Signorini–Coulomb contact
 //! through the bi-potential projection, Raous–Cangémi–Cocou (RCC) recoverable adhesion, and the
 //! point solver used inside the nonlinear Gauss–Seidel sweep over contact points.
 //!
@@ -21,15 +21,17 @@
 //! - **Bonds at a distance.** [`beta_update`] follows the RCC law for any gap: from `β₀ = 0` at a
 //!   gap `x` a bond forms when `w/(C_n x²) ≥ ε`, i.e. `x ≤ √(w/(ε C_n)) = 100 x_c` for ε = 1e-4
 //!   (`x_c = √(w/C_n)`). Its traction there is at most `w²/(C_n x³)`. Candidates beyond the
-//!   detection distance are the caller's business: they carry `β = 0` (model.md §5).
+//!   detection distance are the caller's business: they carry `β = 0` (docs/model.md §5).
 //! - **Point solver.** [`solve_point`] solves the apart, stick and slide cases directly (the
 //!   adhesive part implicitly in x) and checks each against the bi-potential fixed point; the
 //!   bi-potential iteration itself (semi-smooth Newton, fixed-point steps with ρ = 1/λ_max(W))
 //!   is the fallback. A plain fixed point diverges once C·A·‖W‖ > 1 if r̃ lags one iteration
 //!   behind x, and crawls when the compliance is ill-conditioned.
 //! - **Sign of the sliding projection.** The paper's eq 32 prints `+ μ n`; with `r_n > 0` as
-//!   compression that leaves the cone, so `− μ n` is used, as model.md says.
+//!   compression that leaves the cone, so `− μ n` is used, as docs/model.md says.
 
+pub use super::anisotropic::Orthotropy;
+use super::anisotropic::{scale, scale_matrix, tangent_scale, unscale, unscale_matrix};
 use std::f64::consts::PI;
 
 /// Default bond cut-off ε of the RCC law: below it a bond is broken.
@@ -57,12 +59,20 @@ pub struct RccParams {
     pub w: f64,
     /// Normal adhesive stiffness C_n [N/m³].
     pub cn: f64,
-    /// Tangential adhesive stiffness C_t [N/m³].
+    /// Tangential adhesive stiffness C_t [N/m³] (along the local axis t₁).
     pub ct: f64,
+    /// Tangential adhesive stiffness along t₂, C_t2 [N/m³]: equal to `ct` except on an
+    /// orthotropic interface, whose t₁, t₂ follow the master's material axes
+    /// ([`super::anisotropic`]).
+    pub ct2: f64,
     /// Interface viscosity b [N·s/m = J·s/m²]; `b = 0` is the rate-independent limit.
     pub b: f64,
     /// Cut-off ε of the intensity of adhesion β [-] (default [`DEFAULT_BETA_EPS`]).
     pub eps: f64,
+    /// Fatigue energy D_f [J/m²] of the interface: the decohesion energy degrades as
+    /// w(D) = w·exp(−D/D_f) with the adhesive energy D dissipated at the point so far
+    /// ([`accumulated_damage`]). `f64::INFINITY` (the default) is the RCC law without fatigue.
+    pub fatigue_energy: f64,
 }
 
 impl RccParams {
@@ -72,9 +82,21 @@ impl RccParams {
             w,
             cn,
             ct,
+            ct2: ct,
             b,
             eps: DEFAULT_BETA_EPS,
+            fatigue_energy: f64::INFINITY,
         }
+    }
+
+    /// The parameters at a point that has dissipated `damage` = D [J/m²]: the decohesion
+    /// energy w·exp(−D/D_f), everything else unchanged.
+    pub fn degraded(&self, damage: f64) -> RccParams {
+        let mut p = *self;
+        if self.fatigue_energy.is_finite() && damage > 0.0 {
+            p.w = self.w * (-damage / self.fatigue_energy).exp();
+        }
+        p
     }
 
     /// Critical opening x_c = √(w/C_n) [m] where the quasi-static normal traction peaks.
@@ -88,17 +110,21 @@ impl RccParams {
 
     /// Largest quasi-static adhesive traction √(max(C_n, C_t)·w) [Pa].
     pub fn peak_traction(&self) -> f64 {
-        (self.cn.max(self.ct).max(0.0) * self.w.max(0.0)).sqrt()
+        (self.cn.max(self.ct).max(self.ct2).max(0.0) * self.w.max(0.0)).sqrt()
     }
 }
 
 /// Interface law of a contact pair.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct InterfaceLaw {
-    /// Coulomb friction coefficient μ ≥ 0 [-] (negative values are treated as 0).
+    /// Coulomb friction coefficient μ ≥ 0 [-] (negative values are treated as 0); μ₁, along
+    /// the first material axis, on an orthotropic interface.
     pub mu: f64,
     /// RCC adhesion, or `None` for dry contact.
     pub adhesion: Option<RccParams>,
+    /// Material axes and μ₂ of an orthotropic interface (elliptic friction cone), or `None`
+    /// for an isotropic one ([`super::anisotropic`]).
+    pub anisotropy: Option<Orthotropy>,
 }
 
 /// Which case of the bi-potential projection the dry part fell into. Whether the point is
@@ -120,10 +146,38 @@ pub struct BondState {
     pub beta: f64,
     /// Accumulated stretch of the adhesive links in the (t1, t2) plane [m].
     pub ut: [f64; 2],
+    /// Adhesive energy dissipated at the point so far, D [J/m²] ([`accumulated_damage`]).
+    pub damage: f64,
+}
+
+/// The adhesive energy dissipated at a point, D [J/m²], after a step in which β went from
+/// `beta0` to `beta1`, from its value `damage0` before the step.
+///
+/// Breaking bonds releases the current decohesion energy w(D) per unit of β lost, so
+/// dD = −w(D) dβ while β decreases (re-forming bonds dissipate nothing). With the fatigue law
+/// w(D) = w₀·exp(−D/D_f) of [`RccParams::degraded`] this integrates exactly over any decrease
+/// Δβ: exp(D₁/D_f) = exp(D₀/D_f) + w₀ Δβ / D_f, so the result does not depend on how the
+/// decrease is split into steps. Without fatigue (D_f = ∞) it is D₀ + w₀ Δβ.
+///
+/// Closed form for a point fully bonded and fully broken k times: D_k = D_f ln(1 + k w₀/D_f),
+/// hence w(D_k) = w₀ / (1 + k w₀/D_f) and the quasi-static pull-off traction of cycle k + 1 is
+/// √(C_n w₀ / (1 + k w₀/D_f)).
+pub fn accumulated_damage(damage0: f64, beta0: f64, beta1: f64, p: &RccParams) -> f64 {
+    let lost = (clamp01(beta0) - clamp01(beta1)).max(0.0);
+    let w0 = p.w.max(0.0);
+    if lost == 0.0 || w0 == 0.0 {
+        return damage0;
+    }
+    let df = p.fatigue_energy;
+    if !df.is_finite() {
+        return damage0 + w0 * lost;
+    }
+    // D₁ = D₀ + D_f ln(1 + w₀ Δβ exp(−D₀/D_f) / D_f), in a form exact for small increments.
+    damage0 + df * (w0 * lost * (-damage0 / df).exp() / df).ln_1p()
 }
 
 /// Projection of `r_star` [N] onto the Coulomb cone K_μ = {r_n ≥ 0, ‖r_t‖ ≤ μ r_n}
-/// (model.md §5), with the case it fell into.
+/// (docs/model.md §5), with the case it fell into.
 ///
 /// - separating, `μ‖r*_t‖ < −r*_n`: `r = 0`;
 /// - sticking, `‖r*_t‖ ≤ μ r*_n`: `r = r*`;
@@ -150,7 +204,7 @@ pub fn dry_projection(r_star: [f64; 3], mu: f64) -> ([f64; 3], ContactState) {
     }
 }
 
-/// Bi-potential trial force r* = r̄ − ρ (x + μ‖x_t‖ n) [N] (model.md §5, paper eq 30), from the
+/// Bi-potential trial force r* = r̄ − ρ (x + μ‖x_t‖ n) [N] (docs/model.md §5, paper eq 30), from the
 /// dry force `r_dry` [N], the local relative displacement `x` [m] and ρ [N/m].
 pub fn bipotential_trial(r_dry: [f64; 3], x: [f64; 3], mu: f64, rho: f64) -> [f64; 3] {
     let mu = mu.max(0.0);
@@ -177,13 +231,13 @@ pub fn beta_update(beta0: f64, dt: f64, p: &RccParams, xn: f64, ut: [f64; 2]) ->
     beta_step(beta0, dt, p, stretch_energy(p, xn, ut)).0
 }
 
-/// Adhesive force r̃ = (−C_t u_t1 β² A, −C_t u_t2 β² A, −C_n x_n⁺ β² A) [N] for the intensity of
+/// Adhesive force r̃ = (−C_t u_t1 β² A, −C_t2 u_t2 β² A, −C_n x_n⁺ β² A) [N] for the intensity of
 /// adhesion `beta`, gap `xn` [m], bond stretch `ut` [m] and tributary area `area` [m²].
 pub fn adhesive_force(beta: f64, p: &RccParams, xn: f64, ut: [f64; 2], area: f64) -> [f64; 3] {
     let k = beta * beta * area;
     [
         -p.ct * ut[0] * k,
-        -p.ct * ut[1] * k,
+        -p.ct2 * ut[1] * k,
         -p.cn * xn.max(0.0) * k,
     ]
 }
@@ -334,6 +388,9 @@ struct AdhEval {
 /// Per-solve constants.
 struct Ctx<'a> {
     p: &'a PointProblem<'a>,
+    /// Scale of the second tangential axis of the solver's variables (1, or μ₂/μ₁ on an
+    /// orthotropic interface); the adhesive law is evaluated in the unscaled ones.
+    t2: f64,
     mu: f64,
     /// ρ [N/m] in use (the problem's, or [`default_rho`] when that is not positive).
     rho: f64,
@@ -355,12 +412,47 @@ enum Method {
     Bipotential { newton: bool },
 }
 
+/// [`solve_point`] with a choice of method. An orthotropic law is solved as the isotropic
+/// problem of its scaled variables r' = T⁻¹r, x' = Tx ([`super::anisotropic`]).
 fn solve_point_impl(
     p: &PointProblem,
     r_start: V3,
     tol: f64,
     max_iter: usize,
     method: Method,
+) -> PointSolution {
+    let s = tangent_scale(p.law);
+    if s == 1.0 {
+        return solve_scaled(p, r_start, tol, max_iter, method, 1.0);
+    }
+    let law = InterfaceLaw {
+        anisotropy: None,
+        ..*p.law
+    };
+    let scaled = PointProblem {
+        w_aa: scale_matrix(p.w_aa, s),
+        x_free: scale(p.x_free, s),
+        law: &law,
+        ..*p
+    };
+    let sol = solve_scaled(&scaled, unscale(r_start, s), tol, max_iter, method, s);
+    PointSolution {
+        r_dry: scale(sol.r_dry, s),
+        r_adh: scale(sol.r_adh, s),
+        x: unscale(sol.x, s),
+        ..sol
+    }
+}
+
+/// The point problem `p` in variables whose second tangential axis is scaled by `t2`
+/// (x' = T x, r' = T⁻¹ r, T = diag(1, t2, 1)); `p.law` is isotropic there.
+fn solve_scaled(
+    p: &PointProblem,
+    r_start: V3,
+    tol: f64,
+    max_iter: usize,
+    method: Method,
+    t2: f64,
 ) -> PointSolution {
     let mu = p.law.mu.max(0.0);
     let adh_scale = match &p.law.adhesion {
@@ -380,6 +472,7 @@ fn solve_point_impl(
     };
     let ctx = Ctx {
         p,
+        t2,
         mu,
         rho,
         scale,
@@ -439,13 +532,13 @@ fn solve_by_cases(ctx: &Ctx, r_start: V3, max_iter: usize) -> Result<PointSoluti
         return Err(0);
     }
     // Apart.
-    let ev = evaluate(ctx, [0.0; 3], frozen_adhesion_guess(p, p.x_free));
+    let ev = evaluate(ctx, [0.0; 3], frozen_adhesion_guess(ctx, p.x_free));
     if ev.x[2] >= 0.0 && is_solution(ctx, &ev) {
         return Ok(finish(&ev, ContactState::Apart, 1, true));
     }
     // Stick.
     let r_adh0 = match &p.law.adhesion {
-        Some(a) => adhesion_eval(p, a, [0.0; 3]).force,
+        Some(a) => adhesion_eval(ctx, a, [0.0; 3]).force,
         None => [0.0; 3],
     };
     let r_stick = solve3(p.w_aa, neg(p.x_free)).map(|r| sub(r, r_adh0));
@@ -484,7 +577,7 @@ fn slide_residual(ctx: &Ctx, q: V3) -> (V3, M3, V3, V3) {
     let rd = [mu * rn * c[0], mu * rn * c[1], rn];
     let (ra, k) = match &p.law.adhesion {
         Some(a) => {
-            let ad = adhesion_eval(p, a, x);
+            let ad = adhesion_eval(ctx, a, x);
             (ad.force, ad.stiff)
         }
         None => ([0.0; 3], [[0.0; 3]; 3]),
@@ -630,7 +723,7 @@ fn bipotential_iteration(
     offset: usize,
 ) -> PointSolution {
     let p = ctx.p;
-    let z0 = frozen_adhesion_guess(p, add(p.x_free, matvec(p.w_aa, r0)));
+    let z0 = frozen_adhesion_guess(ctx, add(p.x_free, matvec(p.w_aa, r0)));
     let mut ev = evaluate(ctx, r0, z0);
     let mut iterations = 0;
     let mut converged = false;
@@ -695,7 +788,12 @@ fn evaluate(ctx: &Ctx, r_dry: V3, z_start: V3) -> Eval {
 /// Stretch energy density E = C_n x_n⁺² + C_t ‖u_t‖² [N/m].
 fn stretch_energy(p: &RccParams, xn: f64, ut: [f64; 2]) -> f64 {
     let xp = xn.max(0.0);
-    p.cn * xp * xp + p.ct * (ut[0] * ut[0] + ut[1] * ut[1])
+    let tangential = if p.ct2 == p.ct {
+        p.ct * (ut[0] * ut[0] + ut[1] * ut[1])
+    } else {
+        p.ct * ut[0] * ut[0] + p.ct2 * ut[1] * ut[1]
+    };
+    p.cn * xp * xp + tangential
 }
 
 /// β₁ and c = −(∂β₁/∂E)/β₁ [m/N] (0 where β₁ is clamped, cut or frozen).
@@ -735,12 +833,21 @@ fn beta_step(beta0: f64, dt: f64, p: &RccParams, e: f64) -> (f64, f64) {
 /// The adhesive law at x: β₁, u_t, r̃, −∂r̃/∂x and the incremental potential
 /// φ = A [½ E β₁² − w β₁ + b/(2Δt) (β₁ − β₀)²] (β₁ minimises the bracket over [0, 1], so
 /// ∂φ/∂x = A β₁² ∂E/∂x / 2 = −r̃).
-fn adhesion_eval(p: &PointProblem, a: &RccParams, x: V3) -> AdhEval {
-    adhesion_at(p.bond0, p.dt, p.area, a, x)
+fn adhesion_eval(ctx: &Ctx, a: &RccParams, x: V3) -> AdhEval {
+    let (p, s) = (ctx.p, ctx.t2);
+    if s == 1.0 {
+        return adhesion_at(p.bond0, p.dt, p.area, a, x);
+    }
+    // x is scaled (x' = T x): the law at T⁻¹x', its force as T⁻¹r̃ and stiffness T⁻¹KT⁻¹.
+    let mut ev = adhesion_at(p.bond0, p.dt, p.area, a, unscale(x, s));
+    ev.force = unscale(ev.force, s);
+    ev.stiff = unscale_matrix(ev.stiff, s);
+    ev
 }
 
 /// [`adhesion_eval`] from the committed bond state, Δt [s] and tributary area [m²].
 fn adhesion_at(bond0: BondState, dt: f64, area: f64, a: &RccParams, x: V3) -> AdhEval {
+    let a = &a.degraded(bond0.damage);
     let ut = [bond0.ut[0] + x[0], bond0.ut[1] + x[1]];
     let e = stretch_energy(a, x[2], ut);
     let (beta, c) = beta_step(bond0.beta, dt, a, e);
@@ -755,9 +862,9 @@ fn adhesion_at(bond0: BondState, dt: f64, area: f64, a: &RccParams, x: V3) -> Ad
     let mut stiff = [[0.0; 3]; 3];
     if beta > 0.0 {
         let k = area * beta * beta;
-        let v = [a.ct * ut[0], a.ct * ut[1], a.cn * xp];
+        let v = [a.ct * ut[0], a.ct2 * ut[1], a.cn * xp];
         let dn = if x[2] > 0.0 { a.cn } else { 0.0 };
-        let diag = [a.ct, a.ct, dn];
+        let diag = [a.ct, a.ct2, dn];
         for i in 0..3 {
             for j in 0..3 {
                 let d = if i == j { diag[i] } else { 0.0 };
@@ -774,7 +881,7 @@ fn adhesion_at(bond0: BondState, dt: f64, area: f64, a: &RccParams, x: V3) -> Ad
     }
 }
 
-/// The RCC adhesive response at a local relative displacement x [m] (model.md §5), for a
+/// The RCC adhesive response at a local relative displacement x [m] (docs/model.md §5), for a
 /// point whose committed bond state is `bond0`, over a step of `dt` [s], with tributary area
 /// `area` [m²].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -805,7 +912,7 @@ pub fn adhesive_response(
     let mut secant_stiffness = [[0.0; 3]; 3];
     if ev.beta > 0.0 {
         secant_stiffness[0][0] = k * a.ct;
-        secant_stiffness[1][1] = k * a.ct;
+        secant_stiffness[1][1] = k * a.ct2;
         secant_stiffness[2][2] = if x[2] > 0.0 { k * a.cn } else { 0.0 };
     }
     AdhesiveResponse {
@@ -819,7 +926,8 @@ pub fn adhesive_response(
 
 /// Adhesive force guess with β frozen at β₀ (linear springs), given y = x_free + W r̄:
 /// z = −K₀ (y + e + W z), K₀ = A β₀² diag(C_t, C_t, C_n [y_n > 0]), e = (u_t0, 0).
-fn frozen_adhesion_guess(p: &PointProblem, y: V3) -> V3 {
+fn frozen_adhesion_guess(ctx: &Ctx, y: V3) -> V3 {
+    let (p, s) = (ctx.p, ctx.t2);
     let a = match &p.law.adhesion {
         Some(a) => a,
         None => return [0.0; 3],
@@ -829,10 +937,15 @@ fn frozen_adhesion_guess(p: &PointProblem, y: V3) -> V3 {
     if k.is_nan() || k <= 0.0 {
         return [0.0; 3];
     }
-    let kd = [k * a.ct, k * a.ct, if y[2] > 0.0 { k * a.cn } else { 0.0 }];
+    // In scaled variables the springs are T⁻¹KT⁻¹ and the stretch T e.
+    let kd = [
+        k * a.ct,
+        k * a.ct2 / (s * s),
+        if y[2] > 0.0 { k * a.cn } else { 0.0 },
+    ];
     let rhs = [
         -kd[0] * (y[0] + p.bond0.ut[0]),
-        -kd[1] * (y[1] + p.bond0.ut[1]),
+        -kd[1] * (y[1] + s * p.bond0.ut[1]),
         -kd[2] * y[2],
     ];
     let mut m = identity();
@@ -860,7 +973,7 @@ fn solve_adhesion(ctx: &Ctx, a: &RccParams, y: V3, z_start: V3) -> (V3, V3, AdhE
         [0.0; 3]
     };
     let mut x = add(y, matvec(w, z));
-    let mut ad = adhesion_eval(p, a, x);
+    let mut ad = adhesion_eval(ctx, a, x);
     for _ in 0..MAX_INNER {
         let res = sub(z, ad.force);
         let size = norm(z) + norm(ad.force) + ctx.scale;
@@ -895,7 +1008,7 @@ fn solve_adhesion(ctx: &Ctx, a: &RccParams, y: V3, z_start: V3) -> (V3, V3, AdhE
         for _ in 0..MAX_HALVINGS {
             let zt = axpy(z, alpha, d);
             let xt = add(y, matvec(w, zt));
-            let at = adhesion_eval(p, a, xt);
+            let at = adhesion_eval(ctx, a, xt);
             let pit = merit(zt, w, at.energy);
             let slack = 1e-13 * (pi0.abs() + pit.abs());
             if pit <= pi0 + 1e-4 * alpha * slope + slack {
@@ -907,7 +1020,7 @@ fn solve_adhesion(ctx: &Ctx, a: &RccParams, y: V3, z_start: V3) -> (V3, V3, AdhE
         let (zn, xn, an) = accepted.unwrap_or_else(|| {
             let zt = add(z, d);
             let xt = add(y, matvec(w, zt));
-            (zt, xt, adhesion_eval(p, a, xt))
+            (zt, xt, adhesion_eval(ctx, a, xt))
         });
         let moved = norm(sub(zn, z));
         z = zn;
@@ -1237,6 +1350,7 @@ mod tests {
     const DRY: InterfaceLaw = InterfaceLaw {
         mu: 0.3,
         adhesion: None,
+        anisotropy: None,
     };
 
     /// Paper-like interface: w = 20 J/m², C_n = C_t = 2e9 N/m³ (x_c = 0.1 mm), b = 0.1 N·s/m.
@@ -1256,7 +1370,7 @@ mod tests {
         }
     }
 
-    /// Independent check of a point solution against the laws of model.md §5: x = x_free + W r,
+    /// Independent check of a point solution against the laws of docs/model.md §5: x = x_free + W r,
     /// r̄ ∈ K_μ, Signorini complementarity, Coulomb sliding rule, and the RCC part.
     fn check_solution(p: &PointProblem, s: &PointSolution, tol: f64) {
         let r = s.r();
@@ -1320,7 +1434,7 @@ mod tests {
         // Sticking: ‖r*_t‖ = 0.5 ≤ 1 = μ r*_n.
         let (r, c) = dry_projection([0.3, 0.4, 2.0], 0.5);
         assert_eq!((r, c), ([0.3, 0.4, 2.0], ContactState::Stick));
-        // Sliding, model.md's example: μ = 1, r* = (2, 0, 0) → r_n = 1, r_t = (1, 0).
+        // Sliding (docs/model.md §5.1): μ = 1, r* = (2, 0, 0) → r_n = 1, r_t = (1, 0).
         let (r, c) = dry_projection([2.0, 0.0, 0.0], 1.0);
         assert_eq!(c, ContactState::Slide);
         assert_vec_close(r, [1.0, 0.0, 1.0], 1e-15);
@@ -1558,9 +1672,11 @@ mod tests {
         let mut rng = Rng(11);
         for _ in 0..10_000 {
             let p = RccParams {
+                fatigue_energy: f64::INFINITY,
                 w: rng.uniform(0.0, 50.0),
                 cn: 10f64.powf(rng.uniform(6.0, 12.0)),
                 ct: 10f64.powf(rng.uniform(6.0, 12.0)),
+                ct2: f64::NAN,
                 b: if rng.uniform(0.0, 1.0) < 0.2 {
                     0.0
                 } else {
@@ -1568,6 +1684,7 @@ mod tests {
                 },
                 eps: DEFAULT_BETA_EPS,
             };
+            let p = RccParams { ct2: p.ct, ..p };
             let beta0 = rng.uniform(0.0, 1.0);
             let xn = rng.uniform(-1e-3, 1e-3);
             let ut = [rng.uniform(-1e-3, 1e-3), rng.uniform(-1e-3, 1e-3)];
@@ -1659,6 +1776,7 @@ mod tests {
         let law = InterfaceLaw {
             mu: 0.3,
             adhesion: Some(rcc),
+            anisotropy: None,
         };
         let xc = rcc.critical_opening();
         let area = 1e-6;
@@ -1666,6 +1784,7 @@ mod tests {
         let mut bond = BondState {
             beta: 1.0,
             ut: [0.0; 2],
+            damage: 0.0,
         };
         let mut peak = 0.0_f64;
         for k in 1..=10_000 {
@@ -1684,6 +1803,7 @@ mod tests {
             bond = BondState {
                 beta: s.beta,
                 ut: s.ut,
+                damage: 0.0,
             };
         }
         assert!(
@@ -1700,11 +1820,13 @@ mod tests {
         let law = InterfaceLaw {
             mu: 0.4,
             adhesion: Some(paper_rcc()),
+            anisotropy: None,
         };
         let w = diag(0.05, 0.05, 0.05);
         let bond = BondState {
             beta: 1.0,
             ut: [2e-5, 0.0],
+            damage: 0.0,
         };
         // r̃(0) = (−0.04, 0, 0) N; pressing with 0.2 N gives μ r_n = 0.08 N.
         for (shear, state) in [(0.0, ContactState::Stick), (-5e-3, ContactState::Slide)] {
@@ -1776,6 +1898,7 @@ mod tests {
         let law = InterfaceLaw {
             mu: 0.0,
             adhesion: None,
+            anisotropy: None,
         };
         let p = problem(&law, w, [3e-5, 4e-5, -1e-4], BondState::default());
         let s = solve_point(&p, [0.0; 3], 1e-12, 50);
@@ -1801,10 +1924,12 @@ mod tests {
         let law = InterfaceLaw {
             mu: 0.3,
             adhesion: Some(paper_rcc()),
+            anisotropy: None,
         };
         let bond = BondState {
             beta: 1.0,
             ut: [0.0; 2],
+            damage: 0.0,
         };
         // C_n A = 2e3 N/m; C_n A W_nn = 0.2 (soft) and 100 (stiff adhesion).
         for wnn in [1e-4, 5e-2] {
@@ -1828,12 +1953,14 @@ mod tests {
         let law = InterfaceLaw {
             mu: 0.3,
             adhesion: Some(paper_rcc()),
+            anisotropy: None,
         };
         let w = diag(1e-4, 1e-4, 1e-4);
         // Bonded, pressed and pulled sideways: stretch grows by the slip, bond survives.
         let bond = BondState {
             beta: 1.0,
             ut: [1e-6, 0.0],
+            damage: 0.0,
         };
         let p = problem(&law, w, [2e-3, 0.0, -1e-3], bond);
         let s = solve_point(&p, [0.0; 3], 1e-12, 100);
@@ -1845,6 +1972,7 @@ mod tests {
         let bond = BondState {
             beta: 2e-4,
             ut: [1e-6, 0.0],
+            damage: 0.0,
         };
         let mut p = problem(&law, w, [0.0, 0.0, 3e-2], bond);
         p.dt = 1.0;
@@ -1881,6 +2009,7 @@ mod tests {
             let law = InterfaceLaw {
                 mu,
                 adhesion: if ratio > 0.0 { Some(rcc) } else { None },
+                anisotropy: None,
             };
             let xc = rcc.critical_opening();
             let a = 10f64.powf(rng.uniform(-2.0, 0.7)) * xc * (1.0 + ratio);
@@ -1892,6 +2021,7 @@ mod tests {
             let bond = BondState {
                 beta: [0.0, 1.0, 0.5, 0.01][(i / 3) % 4],
                 ut: [xc * rng.uniform(-0.5, 0.5), xc * rng.uniform(-0.5, 0.5)],
+                damage: 0.0,
             };
             let p = PointProblem {
                 w_aa: w,
@@ -1962,6 +2092,7 @@ mod tests {
             let law = InterfaceLaw {
                 mu: [0.0, 0.3, 0.8][i % 3],
                 adhesion: None,
+                anisotropy: None,
             };
             let x_free = [
                 rng.uniform(-1e-4, 1e-4),
@@ -2002,6 +2133,7 @@ mod tests {
         let law = InterfaceLaw {
             mu: 1.0,
             adhesion: None,
+            anisotropy: None,
         };
         let mut p = problem(&law, w, [0.0, 0.0, -1.0], BondState::default());
         let ok = solve_point_impl(
@@ -2039,12 +2171,14 @@ mod tests {
         let law = InterfaceLaw {
             mu: 0.3,
             adhesion: Some(rcc),
+            anisotropy: None,
         };
         let xc = rcc.critical_opening();
         let w = diag(0.05, 0.05, 0.05);
         let mut bond = BondState {
             beta: 1.0,
             ut: [0.0; 2],
+            damage: 0.0,
         };
         let mut r = [0.0; 3];
         let mut snap_off = None;
@@ -2079,6 +2213,7 @@ mod tests {
             bond = BondState {
                 beta: s.beta,
                 ut: s.ut,
+                damage: 0.0,
             };
             r = s.r_dry;
         }
@@ -2094,10 +2229,12 @@ mod tests {
         let law = InterfaceLaw {
             mu: 0.5,
             adhesion: Some(rcc),
+            anisotropy: None,
         };
         let bond = BondState {
             beta: 1.0,
             ut: [1e-5, 0.0],
+            damage: 0.0,
         };
         let cases: [(M3, V3, f64, f64); 6] = [
             ([[0.0; 3]; 3], [0.0, 0.0, -1e-4], 1e-6, 1e-4),
@@ -2138,5 +2275,88 @@ mod tests {
         };
         let s = solve_point(&p, [0.0; 3], 1e-10, 10);
         assert!(s.converged && s.r() == [0.0; 3]);
+    }
+
+    /// Without fatigue, D counts w per unit of β lost and nothing for β gained.
+    #[test]
+    fn damage_without_fatigue_is_w_times_the_beta_lost() {
+        let p = paper_rcc();
+        assert_eq!(accumulated_damage(3.0, 0.8, 0.3, &p), 3.0 + 20.0 * 0.5);
+        assert_eq!(accumulated_damage(3.0, 0.3, 0.8, &p), 3.0);
+        assert_eq!(p.degraded(1e6), p);
+    }
+
+    /// The fatigue update integrates dD = −w(D) dβ exactly: the damage after a full break does
+    /// not depend on how the decrease of β is split into steps, and after k full breaks it is
+    /// D_f ln(1 + k w₀/D_f).
+    #[test]
+    fn fatigue_damage_is_path_independent_and_matches_its_closed_form() {
+        let mut p = paper_rcc();
+        p.fatigue_energy = 50.0;
+        let (w0, df) = (p.w, p.fatigue_energy);
+        let mut d_one = 0.0;
+        let mut d_many = 0.0;
+        for k in 1..=5 {
+            d_one = accumulated_damage(d_one, 1.0, 0.0, &p);
+            // 1000 uneven steps from β = 1 to 0.
+            let mut beta = 1.0;
+            for i in 0..1000 {
+                let next = if i == 999 {
+                    0.0
+                } else {
+                    beta * (1.0 - 0.004 * (1.0 + (i % 7) as f64 / 7.0))
+                };
+                d_many = accumulated_damage(d_many, beta, next, &p);
+                beta = next;
+            }
+            let closed = df * (1.0 + k as f64 * w0 / df).ln();
+            assert!(
+                (d_one - closed).abs() < 1e-12 * closed,
+                "k = {k}: {d_one} vs {closed}"
+            );
+            assert!(
+                (d_many - closed).abs() < 1e-12 * closed,
+                "k = {k}: {d_many} vs {closed}"
+            );
+            let w_k = p.degraded(d_one).w;
+            let expect = w0 / (1.0 + k as f64 * w0 / df);
+            assert!(
+                (w_k - expect).abs() < 1e-12 * expect,
+                "k = {k}: w {w_k} vs {expect}"
+            );
+        }
+    }
+
+    /// The adhesive force of a damaged bond peaks at the degraded traction √(C_n w(D)) A:
+    /// a rate-independent bond (b = 0) pulled open from β = 1.
+    #[test]
+    fn damaged_bond_peaks_at_the_degraded_traction() {
+        let mut p = RccParams::new(20.0, 2e9, 2e9, 0.0);
+        p.fatigue_energy = 40.0;
+        let area = 1e-6;
+        for k in 0..4 {
+            let damage = p.fatigue_energy * (1.0 + k as f64 * p.w / p.fatigue_energy).ln();
+            let bond = BondState {
+                beta: 1.0,
+                ut: [0.0; 2],
+                damage,
+            };
+            let xc = p.degraded(damage).critical_opening();
+            // The force rises linearly to its kink at x_c and falls as x⁻³ beyond: sample on a
+            // grid through x_c.
+            let peak = (1..=3000)
+                .map(|i| {
+                    let x = [0.0, 0.0, xc * i as f64 / 1000.0];
+                    -adhesive_response(&p, bond, 1e-3, area, x).force[2]
+                })
+                .fold(0.0, f64::max);
+            let expect = area * (p.cn * p.w / (1.0 + k as f64 * p.w / p.fatigue_energy)).sqrt();
+            // The sampled maximum of a smooth peak: 4000 samples over 3 x_c put it within
+            // (3/4000)² of the true maximum.
+            assert!(
+                (peak - expect).abs() < 1e-6 * expect,
+                "k = {k}: {peak} vs {expect}"
+            );
+        }
     }
 }

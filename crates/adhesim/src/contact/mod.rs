@@ -1,4 +1,4 @@
-//! Frictional contact with recoverable adhesion (model.md §4-§7).
+//! Frictional contact with recoverable adhesion (docs/model.md §4-§7).
 //!
 //! - [`law`]: the local law at one contact point (bi-potential projection, RCC β update, the
 //!   point solver) — pure functions.
@@ -6,6 +6,7 @@
 //! - [`solve`]: the reduced contact system inside Newton (Delassus operator W = H K̄⁻¹ Hᵀ,
 //!   nonlinear Gauss-Seidel over contact points).
 
+pub mod anisotropic;
 pub mod detect;
 pub mod law;
 pub mod natural_map;

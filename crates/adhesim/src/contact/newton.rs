@@ -3,7 +3,7 @@
 //! factorisation whatever the number of contact points and the memory grows linearly with them.
 //!
 //! At every contact point α the dry force is written through the bi-potential projection with
-//! a multiplier estimate λ_α (model.md §5):
+//! a multiplier estimate λ_α (docs/model.md §5):
 //!
 //!   r̄_α(u) = P_K(λ_α − ρ_α x̂_α(u)),   x̂ = x + μ‖x_t‖ n,
 //!
@@ -18,6 +18,7 @@
 //!
 //! Everything here is pure: the stepper owns the loop.
 
+use super::anisotropic::{scale, scale_matrix, tangent_scale, unscale};
 use super::detect::ContactPoint;
 use super::law::{
     adhesive_response, bipotential_trial, dry_projection, BondState, ContactState, InterfaceLaw,
@@ -43,7 +44,7 @@ pub struct AugmentedPoint {
 }
 
 /// The bi-potential projection P_K(r − ρ x̂) of a dry force `r` [N] at `x` [m]: `r` is a
-/// solution of the dry contact law at `x` exactly when this returns `r` (model.md §5).
+/// solution of the dry contact law at `x` exactly when this returns `r` (docs/model.md §5).
 pub fn bipotential_projection(mu: f64, rho: f64, r: [f64; 3], x: [f64; 3]) -> [f64; 3] {
     dry_projection(bipotential_trial(r, x, mu, rho), mu).0
 }
@@ -137,7 +138,19 @@ pub fn augmented_point(
     lambda: [f64; 3],
     x: [f64; 3],
 ) -> AugmentedPoint {
-    let dry = augmented_dry_force(law.mu, rho, lambda, x);
+    let s = tangent_scale(law);
+    let dry = if s == 1.0 {
+        augmented_dry_force(law.mu, rho, lambda, x)
+    } else {
+        // Orthotropic: the isotropic law of μ₁ in the scaled variables λ' = T⁻¹λ, x' = Tx;
+        // r = T r', −∂r/∂x = T (−∂r'/∂x') T, the potential is the same.
+        let d = augmented_dry_force(law.mu, rho, unscale(lambda, s), scale(x, s));
+        DryForce {
+            force: scale(d.force, s),
+            stiffness: scale_matrix(d.stiffness, s),
+            ..d
+        }
+    };
     let (r_dry, state, mut stiffness) = (dry.force, dry.state, dry.stiffness);
     let (beta, ut, r_adh, adhesive_energy) = match &law.adhesion {
         Some(a) => {
@@ -269,7 +282,11 @@ mod tests {
     use crate::contact::law::{ContactState, RccParams};
 
     fn dry(mu: f64) -> InterfaceLaw {
-        InterfaceLaw { mu, adhesion: None }
+        InterfaceLaw {
+            mu,
+            adhesion: None,
+            anisotropy: None,
+        }
     }
 
     /// One point on a spring k pushed into a rigid wall, x_n = x_free + r_n/k: the
@@ -360,10 +377,12 @@ mod tests {
         let law = InterfaceLaw {
             mu: 0.0,
             adhesion: Some(a),
+            anisotropy: None,
         };
         let bond0 = BondState {
             beta: 1.0,
             ut: [1e-7, 0.0],
+            damage: 0.0,
         };
         let x = [1e-7, 0.0, 5e-8];
         let ev = augmented_point(&law, bond0, 1e-4, 2e-6, 1e3, [0.0; 3], x);

@@ -215,6 +215,7 @@ pub fn gauss_seidel_sweep(
         let law = InterfaceLaw {
             mu: mu[p],
             adhesion: None,
+            anisotropy: None,
         };
         let problem = PointProblem {
             w_aa: w.diagonal_block(p),

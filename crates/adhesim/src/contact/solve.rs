@@ -1,4 +1,4 @@
-//! The reduced contact system inside a Newton iteration (model.md §6): the Delassus operator
+//! The reduced contact system inside a Newton iteration (docs/model.md §6): the Delassus operator
 //! W = H K̄⁻¹ Hᵀ from one multi-right-hand-side solve with the iteration's factorisation, and
 //! a nonlinear Gauss-Seidel sweep over contact points with the local bi-potential/RCC solve.
 

@@ -23,6 +23,7 @@ pub fn field_label(field: &str) -> Option<&'static str> {
         "pn_adh" => "adhesive normal traction [Pa] (< 0 tension)",
         "tt" => "tangential traction ‖t_t‖ [Pa]",
         "tt_adh" => "adhesive tangential traction [Pa]",
+        "damage" => "dissipated adhesive energy D [J/m²]",
         "fx" => "total contact force F_x [N]",
         "fy" => "total contact force F_y [N]",
         "fz" => "total contact force F_z [N]",

@@ -35,6 +35,7 @@ fn map_label(field: &str) -> &'static str {
         "pn_adh" => "adhesive normal traction [Pa]",
         "tt" => "tangential traction ‖t_t‖ [Pa]",
         "tt_adh" => "adhesive tangential traction [Pa]",
+        "damage" => "dissipated adhesive energy D [J/m²]",
         _ => "",
     }
 }

@@ -280,6 +280,7 @@ impl Observer for FrameWriter {
                 .with_point_data("slip", vtk::FieldData::Scalar(&c.slip))
                 .with_point_data("ut", vtk::FieldData::Vector(&c.ut))
                 .with_point_data("state", vtk::FieldData::Int(&c.state))
+                .with_point_data("damage", vtk::FieldData::Scalar(&c.damage))
                 .with_cell_data("pair_id", vtk::FieldData::Int(&c.pair_id))
                 .with_cell_data("body_id", vtk::FieldData::Int(&c.body_id));
             let file = format!("{stem}_contact{j}.vtu");
@@ -343,6 +344,7 @@ struct ContactFrame {
     slip: Vec<f64>,
     ut: Vec<[f64; 3]>,
     state: Vec<i32>,
+    damage: Vec<f64>,
     pair_id: Vec<i32>,
     body_id: Vec<i32>,
 }
@@ -407,6 +409,7 @@ fn contact_frame(
             .collect(),
         ut: nodes.iter().map(|c| c.ut).collect(),
         state: nodes.iter().map(|c| c.state).collect(),
+        damage: nodes.iter().map(|c| c.damage).collect(),
         pair_id: vec![id_i32(index); n_cells],
         body_id: vec![id_i32(slave_body); n_cells],
     };
@@ -642,17 +645,17 @@ fn unit(a: [f64; 3]) -> [f64; 3] {
 
 /// Contact fields of one slave node, as written for tracked nodes in the history and in the
 /// contact maps; [`contact_node_values`] gives them in this order.
-pub const CONTACT_NODE_FIELDS: [&str; 13] = [
+pub const CONTACT_NODE_FIELDS: [&str; 14] = [
     "beta", "rn", "rn_dry", "rn_adh", "rt", "rt_adh", "gap", "slip", "state", "pn", "pn_adh", "tt",
-    "tt_adh",
+    "tt_adh", "damage",
 ];
 
 /// The [`CONTACT_NODE_FIELDS`] of one slave node of tributary area `area` [m²]: β, total,
 /// dry and adhesive normal force [N], norms of the total and adhesive tangential force [N],
 /// gap [m], slip of the step [m], state code, then the same forces as tractions [Pa]:
 /// contact pressure, adhesive normal traction, norms of the total and adhesive tangential
-/// tractions.
-pub fn contact_node_values(c: &NodeContact, area: f64) -> [f64; 13] {
+/// tractions; last the adhesive energy dissipated so far [J/m²].
+pub fn contact_node_values(c: &NodeContact, area: f64) -> [f64; 14] {
     let rn = c.r_dry[2] + c.r_adh[2];
     let rt = (c.r_dry[0] + c.r_adh[0]).hypot(c.r_dry[1] + c.r_adh[1]);
     let rt_adh = c.r_adh[0].hypot(c.r_adh[1]);
@@ -670,6 +673,7 @@ pub fn contact_node_values(c: &NodeContact, area: f64) -> [f64; 13] {
         traction(c.r_adh[2], area),
         traction(rt, area),
         traction(rt_adh, area),
+        c.damage,
     ]
 }
 

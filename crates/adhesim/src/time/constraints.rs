@@ -1,0 +1,120 @@
+//! Every prescribed displacement of a problem in one place: which unknowns are fixed, their
+//! values at a time, and the quantities measured on them (reactions).
+
+use crate::problem::Dirichlet;
+
+/// The Dirichlet conditions of a problem and the mask of the unknowns they fix.
+#[derive(Clone, Debug)]
+pub struct Constraints {
+    conditions: Vec<Dirichlet>,
+    fixed: Vec<bool>,
+}
+
+impl Constraints {
+    /// The conditions `conditions` on a model with `num_dofs` unknowns (3 per node).
+    pub fn new(conditions: &[Dirichlet], num_dofs: usize) -> Self {
+        let mut fixed = vec![false; num_dofs];
+        for d in conditions {
+            for &node in &d.nodes {
+                for k in 0..3 {
+                    if d.components[k] {
+                        fixed[3 * node + k] = true;
+                    }
+                }
+            }
+        }
+        Constraints {
+            conditions: conditions.to_vec(),
+            fixed,
+        }
+    }
+
+    /// True for every unknown some condition prescribes.
+    pub fn mask(&self) -> &[bool] {
+        &self.fixed
+    }
+
+    /// Sets the prescribed components of `u` [m] to their values at time `t` [s];
+    /// `reference` holds the nodes' reference positions [m].
+    pub fn impose(&self, reference: &[[f64; 3]], t: f64, u: &mut [f64]) {
+        for d in &self.conditions {
+            for &node in &d.nodes {
+                let ud = d.displacement(reference[node], t);
+                for k in 0..3 {
+                    if d.components[k] {
+                        u[3 * node + k] = ud[k];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Sets the prescribed components of `v` to zero (a residual or a force on free unknowns).
+    pub fn zero_fixed(&self, v: &mut [f64]) {
+        for (x, &fixed) in v.iter_mut().zip(&self.fixed) {
+            if fixed {
+                *x = 0.0;
+            }
+        }
+    }
+
+    /// The components of `out_of_balance` [N] on prescribed unknowns, zero elsewhere: the
+    /// force the supports exert on the bodies when `out_of_balance` is the residual.
+    pub fn reactions(&self, out_of_balance: &[f64]) -> Vec<f64> {
+        out_of_balance
+            .iter()
+            .zip(&self.fixed)
+            .map(|(&g, &fixed)| if fixed { g } else { 0.0 })
+            .collect()
+    }
+
+    /// ‖a − b‖ over the free unknowns.
+    pub fn free_distance(&self, a: &[f64], b: &[f64]) -> f64 {
+        a.iter()
+            .zip(b)
+            .zip(&self.fixed)
+            .filter(|(_, &fixed)| !fixed)
+            .map(|((x, y), _)| (x - y) * (x - y))
+            .sum::<f64>()
+            .sqrt()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::problem::Table;
+
+    fn clamp_x(nodes: Vec<usize>, ux: f64) -> Dirichlet {
+        Dirichlet {
+            nodes,
+            components: [true, false, false],
+            translation: [
+                Table::constant(ux),
+                Table::constant(0.0),
+                Table::constant(0.0),
+            ],
+            rotation: None,
+        }
+    }
+
+    #[test]
+    fn imposes_only_prescribed_components_and_measures_reactions_there() {
+        let c = Constraints::new(&[clamp_x(vec![1], 0.25)], 6);
+        assert_eq!(c.mask(), &[false, false, false, true, false, false]);
+        let mut u = vec![1.0; 6];
+        c.impose(&[[0.0; 3], [1.0, 0.0, 0.0]], 0.0, &mut u);
+        assert_eq!(u, vec![1.0, 1.0, 1.0, 0.25, 1.0, 1.0]);
+        let g = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        assert_eq!(c.reactions(&g), vec![0.0, 0.0, 0.0, 4.0, 0.0, 0.0]);
+        let mut z = g;
+        c.zero_fixed(&mut z);
+        assert_eq!(z, [1.0, 2.0, 3.0, 0.0, 5.0, 6.0]);
+        // Only the free components count: (1−0)² + (5−1)² → √17.
+        let d = c.free_distance(
+            &[1.0, 0.0, 0.0, 9.0, 5.0, 0.0],
+            &[0.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+        );
+        assert!((d - 17f64.sqrt()).abs() < 1e-15);
+    }
+}

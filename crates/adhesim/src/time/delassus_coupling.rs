@@ -1,0 +1,246 @@
+//! The Gauss-Seidel contact solve on the Delassus operator (docs/contact-solver.md): after
+//! each Newton correction, the reduced contact system x = x(u) + H Δu + W (r − r_prev) is
+//! solved point by point and the correction completed by K̄⁻¹Hᵀ(r − r_prev). W is kept
+//! between steps and reused while it is still accurate.
+
+use super::coupling::{ContactCoupling, Evaluated, Iterate, StepContact};
+use super::integrator::norm;
+use super::PhaseTimes;
+use crate::contact::detect::ContactPoint;
+use crate::contact::law::PointSolution;
+use crate::contact::solve::{delassus, gauss_seidel, Delassus};
+use crate::system::SystemMatrix;
+use std::time::Instant;
+
+/// A Newton correction larger than this fraction of the previous one means the contact
+/// coupling is converging slowly: W is rebuilt with the current factorisation.
+const DELASSUS_REUSE_RATIO: f64 = 0.5;
+
+/// Relative change of probed columns of W above which the cached W is rebuilt.
+const DELASSUS_STALE_TOL: f64 = 1e-4;
+
+/// Gauss-Seidel tolerance on the change of the contact forces over a sweep, relative.
+const SWEEP_TOL: f64 = 1e-10;
+
+/// Sweeps after which the contact solve gives up (the step is then cut back).
+const MAX_SWEEPS: usize = 5000;
+
+/// The last Delassus operator and what it was built for (see [`delassus_key`]); kept
+/// between steps.
+pub type DelassusCache = Option<(Vec<u64>, Delassus)>;
+
+/// The Gauss-Seidel contact solve of one step.
+pub struct DelassusCoupling<'a> {
+    sc: StepContact<'a>,
+    cache: &'a mut DelassusCache,
+    key: Vec<u64>,
+    /// Whether this step has built or checked the W in use.
+    checked: bool,
+    builds: usize,
+    prev_du_norm: Option<f64>,
+    /// Total and dry contact forces of the last solve, local frames [N].
+    r_contact: Vec<[f64; 3]>,
+    r_dry: Vec<[f64; 3]>,
+    solutions: Vec<PointSolution>,
+    contact_force: Vec<f64>,
+    contact_residual: f64,
+    sweeps: usize,
+}
+
+impl<'a> DelassusCoupling<'a> {
+    /// The solve of the step with candidates `sc`, reusing W from `cache` where it fits.
+    pub fn new(sc: StepContact<'a>, cache: &'a mut DelassusCache) -> Self {
+        let m = sc.points.len();
+        let n = sc.constraints.mask().len();
+        DelassusCoupling {
+            key: delassus_key(&sc.points, sc.dt),
+            sc,
+            cache,
+            checked: false,
+            builds: 0,
+            prev_du_norm: None,
+            r_contact: vec![[0.0; 3]; m],
+            r_dry: vec![[0.0; 3]; m],
+            solutions: Vec::new(),
+            contact_force: vec![0.0; n],
+            contact_residual: 0.0,
+            sweeps: 0,
+        }
+    }
+
+    /// A W that fits this step and the current factorisation: the cached one when it was
+    /// built for the same points and Δt and (on a first use in the step, or when the Newton
+    /// corrections shrink slowly) three probed columns agree with the current K̄; else a new
+    /// one.
+    fn operator(&mut self, du: &[f64], system: &mut SystemMatrix) {
+        let du_norm = norm(du);
+        let slow = self
+            .prev_du_norm
+            .is_some_and(|p| du_norm > DELASSUS_REUSE_RATIO * p);
+        self.prev_du_norm = Some(du_norm);
+        let mut reusable = matches!(&*self.cache, Some((k, _)) if *k == self.key);
+        // Slow convergence comes from the nonsmooth contact laws as often as from a stale W:
+        // probe the columns of the point carrying the largest force (the first point while
+        // r_contact is still zero) and rebuild only when they differ from the cached ones.
+        if reusable && (slow || !self.checked) {
+            self.checked = true;
+            let probe = self
+                .r_contact
+                .iter()
+                .enumerate()
+                .max_by(|a, b| norm(a.1).total_cmp(&norm(b.1)))
+                .map(|(p, _)| p)
+                .unwrap_or(0);
+            let cached = &self.cache.as_ref().expect("checked").1;
+            let mask = self.sc.constraints.mask();
+            reusable = cached.probed_change(&self.sc.points, probe, system.cholesky(), mask)
+                <= DELASSUS_STALE_TOL;
+        }
+        if !reusable {
+            let mask = self.sc.constraints.mask();
+            let del = delassus(&self.sc.points, system.cholesky(), mask);
+            *self.cache = Some((self.key.clone(), del));
+            self.builds += 1;
+            self.checked = true;
+        }
+    }
+}
+
+impl<'a> ContactCoupling<'a> for DelassusCoupling<'a> {
+    fn step_contact(&mut self) -> &mut StepContact<'a> {
+        &mut self.sc
+    }
+
+    fn evaluate(&mut self, _: &Iterate, _: &mut [f64], _: &mut PhaseTimes) -> Evaluated {
+        Evaluated::Ready
+    }
+
+    fn contact_force(&self) -> &[f64] {
+        &self.contact_force
+    }
+
+    fn contact_residual(&self, _scale: f64) -> f64 {
+        self.contact_residual
+    }
+
+    fn add_tangent(&self, _: &mut SystemMatrix) {}
+
+    fn correct(
+        &mut self,
+        it: &Iterate,
+        u: &[f64],
+        du: &mut [f64],
+        _residual_norm: f64,
+        scale: f64,
+        system: &mut SystemMatrix,
+        timings: &mut PhaseTimes,
+    ) -> Result<(), String> {
+        if self.sc.is_empty() {
+            return Ok(());
+        }
+        let clock = Instant::now();
+        self.operator(du, system);
+        let del = &self.cache.as_ref().expect("built above").1;
+        let m = del.m;
+        // Reduced contact system: x = x(u) + H Δu_free + W (r − r_prev).
+        let x_free: Vec<[f64; 3]> = self
+            .sc
+            .points
+            .iter()
+            .enumerate()
+            .map(|(p, pt)| {
+                let x = pt.local_x(self.sc.reference, u);
+                let h = pt.apply_h(du);
+                let mut xf = [x[0] + h[0], x[1] + h[1], x[2] + h[2]];
+                for (a, xa) in xf.iter_mut().enumerate() {
+                    let row = &del.w[(3 * p + a) * m..(3 * p + a + 1) * m];
+                    for (q, rq) in self.r_contact.iter().enumerate() {
+                        *xa -= row[3 * q] * rq[0] + row[3 * q + 1] * rq[1] + row[3 * q + 2] * rq[2];
+                    }
+                }
+                xf
+            })
+            .collect();
+        timings.delassus += clock.elapsed().as_secs_f64();
+        let clock = Instant::now();
+        let sc = &self.sc;
+        let sol = gauss_seidel(
+            &sc.points,
+            &sc.laws,
+            &sc.bond0,
+            sc.dt,
+            del,
+            &x_free,
+            &self.r_contact,
+            &self.r_dry,
+            SWEEP_TOL,
+            MAX_SWEEPS,
+        );
+        self.sweeps += sol.sweeps;
+        timings.contact_solve += clock.elapsed().as_secs_f64();
+        if !sol.converged {
+            *self.cache = None;
+            return Err(format!(
+                "the contact solve did not settle in {} Gauss-Seidel sweeps (Newton iteration {})",
+                sol.sweeps, it.iter
+            ));
+        }
+        let clock = Instant::now();
+        for (p, ps) in sol.points.iter().enumerate() {
+            self.r_contact[p] = ps.r();
+            self.r_dry[p] = ps.r_dry;
+        }
+        let new_force = self.sc.nodal_force(self.r_contact.iter().copied(), u.len());
+        let mut dc: Vec<f64> = (0..u.len())
+            .map(|i| new_force[i] - self.contact_force[i])
+            .collect();
+        system.solve_in_place(&mut dc);
+        for i in 0..u.len() {
+            du[i] += dc[i];
+        }
+        self.contact_force = new_force;
+        self.solutions = sol.points;
+        self.contact_residual = self.sc.natural_map(&self.solutions) / scale;
+        timings.delassus += clock.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    fn solutions(&self) -> Vec<PointSolution> {
+        self.solutions.clone()
+    }
+
+    fn sweeps(&self) -> usize {
+        self.sweeps
+    }
+
+    fn delassus_builds(&self) -> usize {
+        self.builds
+    }
+
+    fn abandon(&mut self) {
+        *self.cache = None;
+    }
+
+    fn into_points(self: Box<Self>) -> Vec<ContactPoint> {
+        self.sc.points
+    }
+}
+
+/// What W depends on besides K̄: the contact points (pair, node, frame, master weights) and
+/// Δt (K̄ = ξK + M/(θΔt²) + ...). Compared bit for bit.
+fn delassus_key(points: &[ContactPoint], dt: f64) -> Vec<u64> {
+    let mut key = Vec::with_capacity(points.len() * 12 + 1);
+    key.push(dt.to_bits());
+    for p in points {
+        key.push(p.pair as u64);
+        key.push(p.slave as u64);
+        for row in &p.frame {
+            key.extend(row.iter().map(|x| x.to_bits()));
+        }
+        for &(m, w) in &p.master {
+            key.push(m as u64);
+            key.push(w.to_bits());
+        }
+    }
+    key
+}
