@@ -14,6 +14,7 @@
 
 use super::detect::{ContactPair, ContactPoint};
 use super::law::{bipotential_trial, dry_projection, InterfaceLaw};
+use nalgebra::Vector3;
 
 /// The material axes and second friction coefficient of an orthotropic interface.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -39,19 +40,15 @@ pub fn tangent_scale(law: &InterfaceLaw) -> f64 {
 /// master with first axis `axis`: t₁ the normalised projection of `axis` on the tangent plane,
 /// t₂ = n × t₁. None when `axis` is (nearly) normal to the surface.
 pub fn aligned_frame(normal: [f64; 3], axis: [f64; 3]) -> Option<[[f64; 3]; 3]> {
-    let an = dot(axis, normal);
-    let p = [
-        axis[0] - an * normal[0],
-        axis[1] - an * normal[1],
-        axis[2] - an * normal[2],
-    ];
-    let len = dot(p, p).sqrt();
-    if !(len > 1e-6 * dot(axis, axis).sqrt()) {
+    let (n, a) = (Vector3::from(normal), Vector3::from(axis));
+    let projected = a - n * a.dot(&n);
+    let len = projected.norm();
+    if len.is_nan() || len <= 1e-6 * a.norm() {
         return None;
     }
-    let t1 = p.map(|c| c / len);
-    let t2 = cross(normal, t1);
-    Some([t1, t2, normal])
+    let t1 = projected / len;
+    let t2 = n.cross(&t1);
+    Some([t1.into(), t2.into(), normal])
 }
 
 /// Turns the frames of the points of orthotropic pairs to their material axes (points where
@@ -115,18 +112,6 @@ pub fn sliding_friction(mu1: f64, mu2: f64, rn: f64, slip: [f64; 2]) -> [f64; 2]
     [-rn * mu1 * mu1 * slip[0] / m, -rn * mu2 * mu2 * slip[1] / m]
 }
 
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -151,7 +136,8 @@ mod tests {
         assert_eq!(f[0], [1.0, 0.0, 0.0]);
         assert_eq!(f[1], [0.0, 0.0, -1.0]);
         // Right-handed: t₁ × t₂ = n.
-        assert_eq!(cross(f[0], f[1]), n);
+        let t1t2 = Vector3::from(f[0]).cross(&Vector3::from(f[1]));
+        assert_eq!(<[f64; 3]>::from(t1t2), n);
         assert!(aligned_frame(n, [0.0, 3.0, 0.0]).is_none());
     }
 

@@ -134,8 +134,8 @@ impl<'a> ContactCoupling<'a> for NewtonCoupling<'a> {
                 && ls.alpha > MIN_STEP_LENGTH
             {
                 ls.alpha *= 0.5;
-                for i in 0..u.len() {
-                    u[i] = ls.u0[i] + ls.alpha * ls.du[i];
+                for ((ui, u0), du) in u.iter_mut().zip(&ls.u0).zip(&ls.du) {
+                    *ui = u0 + ls.alpha * du;
                 }
                 timings.contact_solve += clock.elapsed().as_secs_f64();
                 return Evaluated::Backtracked;
