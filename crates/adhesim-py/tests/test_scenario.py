@@ -61,10 +61,11 @@ def cantilever_doc() -> dict:
 @pytest.mark.parametrize(
     "edit, key",
     [
-        (lambda d: d["time"].__setitem__("dt", "fast"), "dt"),
-        (lambda d: d["body"][0].__setitem__("densty", 1000.0), "densty"),
-        (lambda d: d["body"][0]["material"].__setitem__("g", -1.0), "g"),
-        (lambda d: d["boundary"][0].__setitem__("set", "nowhere"), "nowhere"),
+        # Type errors quote the line of the dict's TOML form, key included.
+        (lambda d: d["time"].__setitem__("dt", "fast"), 'dt = "fast"'),
+        (lambda d: d["body"][0].__setitem__("densty", 1000.0), "unknown field `densty`"),
+        (lambda d: d["body"][0]["material"].__setitem__("g", -1.0), "`body[0].material.g`"),
+        (lambda d: d["boundary"][0].__setitem__("set", "nowhere"), "`boundary[0].set`"),
     ],
 )
 def test_invalid_scenario_raises_scenario_error_naming_the_key(edit, key):

@@ -14,6 +14,7 @@ gives the messages of `adhesim check`, raised as `ScenarioError`. See docs/pytho
 from __future__ import annotations
 
 import json
+import numbers
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,11 +47,13 @@ def _override_text(key: str, value: Any) -> str:
     if isinstance(value, str):
         # A bare word is read as a string; quoting keeps any text a string.
         return f"{key}={json.dumps(value)}"
-    if isinstance(value, bool):
+    if isinstance(value, (bool, np.bool_)):
         return f"{key}={'true' if value else 'false'}"
-    if isinstance(value, (int, float)):
-        return f"{key}={value!r}"
-    if isinstance(value, (list, tuple)):
+    if isinstance(value, numbers.Integral):
+        return f"{key}={int(value)}"
+    if isinstance(value, numbers.Real):
+        return f"{key}={float(value)!r}"
+    if isinstance(value, (list, tuple, np.ndarray)):
         return f"{key}={_toml_inline(value)}"
     raise ScenarioError(
         f"override `{key}`: cannot write {value!r} as a TOML value "
@@ -59,13 +62,15 @@ def _override_text(key: str, value: Any) -> str:
 
 
 def _toml_inline(value: Any) -> str:
-    if isinstance(value, bool):
+    if isinstance(value, (bool, np.bool_)):
         return "true" if value else "false"
-    if isinstance(value, (int, float)):
-        return repr(float(value)) if isinstance(value, float) else str(value)
+    if isinstance(value, numbers.Integral):
+        return str(int(value))
+    if isinstance(value, numbers.Real):
+        return repr(float(value))
     if isinstance(value, str):
         return json.dumps(value)
-    if isinstance(value, (list, tuple)):
+    if isinstance(value, (list, tuple, np.ndarray)):
         return "[" + ", ".join(_toml_inline(v) for v in value) + "]"
     raise ScenarioError(f"cannot write {value!r} as a TOML value")
 
