@@ -159,7 +159,7 @@ impl Progress for Callback<'_> {
             d.set_item("contact_points", r.contact_points)?;
             let answer = cb.call1((d,))?;
             // Only an explicit False stops: a callback that returns nothing goes on.
-            Ok(!(answer.is_instance_of::<pyo3::types::PyBool>() && !answer.is_truthy()?))
+            Ok(!answer.is_instance_of::<pyo3::types::PyBool>() || answer.is_truthy()?)
         })();
         match result {
             Ok(true) => {}
