@@ -122,53 +122,79 @@ fn check(
     Ok(info.to_string())
 }
 
+/// A stop request that any Python thread can set while a run goes on (the run releases
+/// the interpreter between steps): the run stops after its current step with a checkpoint.
+#[pyclass(module = "adhesim._native")]
+#[derive(Clone, Default)]
+struct StopRequest {
+    flag: Arc<AtomicBool>,
+}
+
+#[pymethods]
+impl StopRequest {
+    #[new]
+    fn new() -> Self {
+        Self::default()
+    }
+    /// Asks the run to stop after its current step.
+    fn set(&self) {
+        self.flag.store(true, Ordering::SeqCst);
+    }
+    /// Whether a stop was asked for.
+    fn is_set(&self) -> bool {
+        self.flag.load(Ordering::SeqCst)
+    }
+}
+
 /// Forwards every committed step to a Python callable; a `False` return value, an
-/// exception in it or Ctrl-C asks the run to stop after the step (with a checkpoint).
-struct Callback<'py> {
-    py: Python<'py>,
-    callback: Option<Bound<'py, PyAny>>,
+/// exception in it or Ctrl-C asks the run to stop after the step (with a checkpoint). The
+/// run itself goes on without the interpreter; each call takes it back.
+struct Callback {
+    callback: Option<Py<PyAny>>,
     stop: Arc<AtomicBool>,
     /// The exception that stopped the run, raised again once the run has ended cleanly.
     error: Option<PyErr>,
     messages: Vec<String>,
 }
 
-impl Progress for Callback<'_> {
+impl Progress for Callback {
     fn step(&mut self, r: &StepReport, t_end: f64) {
         if self.error.is_some() {
             return;
         }
-        if let Err(e) = self.py.check_signals() {
-            self.error = Some(e);
-            self.stop.store(true, Ordering::SeqCst);
-            return;
-        }
-        let Some(cb) = &self.callback else { return };
-        let result = (|| -> PyResult<bool> {
-            let d = PyDict::new(self.py);
-            d.set_item("step", r.step)?;
-            d.set_item("t", r.t)?;
-            d.set_item("t_end", t_end)?;
-            d.set_item("dt", r.dt)?;
-            d.set_item("newton_iterations", r.newton_iterations)?;
-            d.set_item("cutbacks", r.cutbacks)?;
-            d.set_item("residual", r.residual)?;
-            d.set_item("kinetic", r.kinetic)?;
-            d.set_item("internal", r.internal)?;
-            d.set_item("external_work", r.external_work)?;
-            d.set_item("contact_points", r.contact_points)?;
-            let answer = cb.call1((d,))?;
-            // Only an explicit False stops: a callback that returns nothing goes on.
-            Ok(!answer.is_instance_of::<pyo3::types::PyBool>() || answer.is_truthy()?)
-        })();
-        match result {
-            Ok(true) => {}
-            Ok(false) => self.stop.store(true, Ordering::SeqCst),
-            Err(e) => {
+        Python::with_gil(|py| {
+            if let Err(e) = py.check_signals() {
                 self.error = Some(e);
                 self.stop.store(true, Ordering::SeqCst);
+                return;
             }
-        }
+            let Some(cb) = &self.callback else { return };
+            let result = (|| -> PyResult<bool> {
+                let d = PyDict::new(py);
+                d.set_item("step", r.step)?;
+                d.set_item("t", r.t)?;
+                d.set_item("t_end", t_end)?;
+                d.set_item("dt", r.dt)?;
+                d.set_item("newton_iterations", r.newton_iterations)?;
+                d.set_item("cutbacks", r.cutbacks)?;
+                d.set_item("residual", r.residual)?;
+                d.set_item("kinetic", r.kinetic)?;
+                d.set_item("internal", r.internal)?;
+                d.set_item("external_work", r.external_work)?;
+                d.set_item("contact_points", r.contact_points)?;
+                let answer = cb.bind(py).call1((d,))?;
+                // Only an explicit False stops: a callback that returns nothing goes on.
+                Ok(!answer.is_instance_of::<pyo3::types::PyBool>() || answer.is_truthy()?)
+            })();
+            match result {
+                Ok(true) => {}
+                Ok(false) => self.stop.store(true, Ordering::SeqCst),
+                Err(e) => {
+                    self.error = Some(e);
+                    self.stop.store(true, Ordering::SeqCst);
+                }
+            }
+        });
     }
     fn message(&mut self, text: &str) {
         self.messages.push(text.to_string());
@@ -180,7 +206,7 @@ impl Progress for Callback<'_> {
 #[pyfunction]
 #[pyo3(signature = (text, path, out_dir, variant=None, overrides=Vec::new(), callback=None,
     checkpoint_every=100, resume=false, overwrite=false, stop_after_steps=None,
-    from_file=true))]
+    from_file=true, stop=None))]
 #[allow(clippy::too_many_arguments)]
 fn run<'py>(
     py: Python<'py>,
@@ -195,9 +221,10 @@ fn run<'py>(
     overwrite: bool,
     stop_after_steps: Option<usize>,
     from_file: bool,
+    stop: Option<StopRequest>,
 ) -> PyResult<(String, Vec<String>)> {
     let problem = load(text, &path, variant, &overrides)?;
-    let stop = Arc::new(AtomicBool::new(false));
+    let stop = stop.unwrap_or_default().flag;
     let control = RunControl {
         checkpoint_every,
         resume,
@@ -206,14 +233,16 @@ fn run<'py>(
         refuse_existing_run: !overwrite,
     };
     let mut progress = Callback {
-        py,
-        callback,
+        callback: callback.map(Bound::unbind),
         stop,
         error: None,
         messages: Vec::new(),
     };
     let scenario = from_file.then_some(path.as_path());
-    let summary = adhesim::run::run_with(problem, scenario, &out_dir, &mut progress, &control)
+    let summary = py
+        .allow_threads(|| {
+            adhesim::run::run_with(problem, scenario, &out_dir, &mut progress, &control)
+        })
         .map_err(|e| RunError::new_err(format!("{}: {e}", path.display())))?;
     if let Some(e) = progress.error {
         return Err(e);
@@ -321,6 +350,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ScenarioError", py.get_type::<ScenarioError>())?;
     m.add("RunError", py.get_type::<RunError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_class::<StopRequest>()?;
     m.add_function(wrap_pyfunction!(toml_to_json, m)?)?;
     m.add_function(wrap_pyfunction!(json_to_toml, m)?)?;
     m.add_function(wrap_pyfunction!(check, m)?)?;

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import subprocess
+import threading
 
 import numpy as np
 import pytest
@@ -115,6 +116,34 @@ def test_stop_request_leaves_a_checkpoint_that_resumes_to_the_same_history(tmp_p
     resumed = indentation().run(stopped_dir, resume=True, checkpoint_every=0)
     assert resumed.outcome == "finished"
     assert resumed.summary["resumed_from"]["step"] == 20
+    same_history(resumed.history(), reference.history())
+
+
+def test_stop_request_from_another_thread(tmp_path):
+    reference = indentation().run(tmp_path / "reference", checkpoint_every=0)
+    stop = adhesim.StopRequest()
+    reached = threading.Event()
+
+    def watcher():
+        reached.wait(timeout=60)
+        stop.set()
+
+    thread = threading.Thread(target=watcher)
+    thread.start()
+    def signal(step):
+        if step.step == 10:
+            reached.set()  # returns None: the run goes on
+
+    # The callback only signals; the other thread asks for the stop (while the run computes
+    # without the interpreter), so the run ends a step or a few later.
+    run_dir = tmp_path / "stopped"
+    run = indentation().run(run_dir, stop=stop, checkpoint_every=0, progress=signal)
+    thread.join()
+    assert stop.is_set()
+    assert run.outcome == "interrupted"
+    assert 10 <= run.summary["steps"] < 50
+    assert (run_dir / "checkpoint.bin").exists()
+    resumed = indentation().run(run_dir, resume=True, checkpoint_every=0)
     same_history(resumed.history(), reference.history())
 
 

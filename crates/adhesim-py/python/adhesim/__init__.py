@@ -23,7 +23,7 @@ from typing import Any, Callable, Iterable, Mapping
 import numpy as np
 
 from . import _native
-from ._native import AdhesimError, RunError, ScenarioError
+from ._native import AdhesimError, RunError, ScenarioError, StopRequest
 from .frames import Frame, read_frame, read_frames, frame_times
 
 __version__ = _native.__version__
@@ -36,6 +36,7 @@ __all__ = [
     "Scenario",
     "ScenarioError",
     "Step",
+    "StopRequest",
     "SweepResult",
     "read_history",
     "sweep",
@@ -195,12 +196,15 @@ class Scenario:
         resume: bool = False,
         overwrite: bool = False,
         stop_after_steps: int | None = None,
+        stop: StopRequest | None = None,
     ) -> "Run":
         """Runs the scenario into the folder `out`, as `adhesim run` does.
 
         `progress(step)` is called after every committed step with a `Step`; returning
         False (not None) stops the run after that step with a checkpoint, as Ctrl-C does
         for the command line (Ctrl-C here does the same, then raises KeyboardInterrupt).
+        `stop`, a `StopRequest`, does the same when another thread calls `stop.set()`:
+        the run releases the interpreter while it computes.
         `resume=True` continues an interrupted run in `out` from its checkpoint;
         `overwrite=True` replaces a previous run there. Raises `ScenarioError` for an
         invalid scenario and `RunError` when the run cannot start or write its outputs; a
@@ -224,6 +228,7 @@ class Scenario:
             overwrite=overwrite,
             stop_after_steps=stop_after_steps,
             from_file=self._from_file,
+            stop=stop,
         )
         return Run(out, messages=messages)
 
