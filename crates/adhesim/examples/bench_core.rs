@@ -1024,7 +1024,7 @@ fn bench_dynamic(n: usize, steps: usize, threads: usize) -> DynamicResult {
             },
         ],
         loads: vec![],
-        gravity: [0.0; 3],
+        gravity: Default::default(),
         time: TimeSettings {
             t_end,
             dt: t_end / steps as f64,

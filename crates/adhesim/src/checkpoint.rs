@@ -502,7 +502,7 @@ mod tests {
             bodies: vec![],
             dirichlet: vec![],
             loads: vec![],
-            gravity: [0.0; 3],
+            gravity: Default::default(),
             time: crate::problem::TimeSettings {
                 t_end,
                 ..time.clone()

@@ -10,8 +10,10 @@
 pub mod assembly;
 pub mod checkpoint;
 pub mod contact;
+pub mod diagnosis;
 pub mod element;
 pub mod fbar;
+pub mod gravity;
 pub mod linalg;
 pub mod material;
 pub mod mesh;

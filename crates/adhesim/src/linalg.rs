@@ -15,9 +15,10 @@ use faer::{Conj, MatMut, Par, Side, Spec};
 /// Errors of the linear-algebra layer.
 #[derive(Debug, thiserror::Error)]
 pub enum LinalgError {
-    /// The matrix is not numerically positive definite (e.g. an element turned inside out or
-    /// a body is not held against rigid motion in a quasi-static run).
-    #[error("the system matrix is not positive definite (a body may be unconstrained in a quasi-static run, or the mesh is too distorted)")]
+    /// The matrix is not numerically positive definite (e.g. an element turned inside out, a
+    /// body not held against rigid motion in a quasi-static run, or a quasi-static load
+    /// increment too large; [`crate::diagnosis`] tells which from the problem).
+    #[error("the system matrix is not positive definite")]
     NotPositiveDefinite,
     /// Ordering or symbolic analysis failed.
     #[error("symbolic analysis of the system matrix failed: {0}")]

@@ -227,8 +227,8 @@ pub struct Problem {
     pub dirichlet: Vec<Dirichlet>,
     /// Nodal loads.
     pub loads: Vec<NodalLoad>,
-    /// Gravity acceleration [m/s²].
-    pub gravity: [f64; 3],
+    /// Gravity acceleration over time [m/s²].
+    pub gravity: crate::gravity::Gravity,
     /// Time integration.
     pub time: TimeSettings,
     /// Contact pairs.

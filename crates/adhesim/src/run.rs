@@ -341,8 +341,9 @@ pub fn run_with(
                     }
                 }
                 Err(e) => {
-                    progress.message(&e.to_string());
-                    summary.outcome = Outcome::Failed(e.to_string());
+                    let message = crate::diagnosis::describe_step_failure(&problem, &e);
+                    progress.message(&message);
+                    summary.outcome = Outcome::Failed(message);
                     return Ok(());
                 }
             }

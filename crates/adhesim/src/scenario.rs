@@ -40,7 +40,7 @@ struct FileScenario {
     name: Option<String>,
     time: FileTime,
     #[serde(default)]
-    gravity: Option<[f64; 3]>,
+    gravity: Option<FileGravity>,
     #[serde(rename = "body")]
     bodies: Vec<FileBody>,
     #[serde(default, rename = "boundary")]
@@ -182,6 +182,18 @@ struct FileMaterial {
 enum FileTable {
     Constant(f64),
     Points(Vec<[f64; 2]>),
+}
+
+/// `gravity = [gx, gy, gz]`, or tables per component as for loads.
+#[derive(Deserialize, Debug)]
+#[serde(
+    untagged,
+    expecting = "a vector [gx, gy, gz] [m/s²], or components over time such as \
+                 { y = [[0.0, 0.0], [1.0, -9.81]] } (each x, y, z a number or [[t, g], ...])"
+)]
+enum FileGravity {
+    Constant([f64; 3]),
+    Tables(FileComponents),
 }
 
 #[derive(Deserialize, Debug, Default)]
@@ -709,7 +721,24 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
             node: local + offsets[bi],
         });
     }
-    let gravity = ctx.finite3("gravity", raw.gravity.unwrap_or([0.0; 3]))?;
+    let gravity = match &raw.gravity {
+        None => crate::gravity::Gravity::default(),
+        Some(FileGravity::Constant(g)) => {
+            crate::gravity::Gravity::constant(ctx.finite3("gravity", *g)?)
+        }
+        Some(FileGravity::Tables(c)) => {
+            let mut g = crate::gravity::Gravity::default();
+            for (k, (cname, t)) in [("x", &c.x), ("y", &c.y), ("z", &c.z)]
+                .into_iter()
+                .enumerate()
+            {
+                if let Some(t) = t {
+                    g.components[k] = build_table(t, &format!("gravity.{cname}"), ctx)?;
+                }
+            }
+            g
+        }
+    };
     let frame_interval = match raw.output.as_ref().and_then(|o| o.frame_interval) {
         None => 0.0,
         Some(v) if v.is_finite() && v >= 0.0 => v,

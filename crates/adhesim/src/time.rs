@@ -193,7 +193,8 @@ pub struct Stepper {
     /// Committed state.
     pub state: State,
     inertia: Inertia,
-    gravity_force: Vec<f64>,
+    /// Gravity force per unit acceleration along x, y, z [N/(m/s²)].
+    gravity_force: [Vec<f64>; 3],
     system: SystemMatrix,
     constraints: Constraints,
     dt: f64,
@@ -253,12 +254,8 @@ impl Stepper {
         } else {
             None
         };
-        let mut g = vec![0.0; n];
-        for i in 0..disc.num_nodes {
-            g[3 * i..3 * i + 3].copy_from_slice(&problem.gravity);
-        }
-        let mut gravity_force = vec![0.0; n];
-        disc.pattern.symmetric_matvec(&mass, &g, &mut gravity_force);
+        let gravity_force =
+            crate::gravity::unit_forces(n, |x, y| disc.pattern.symmetric_matvec(&mass, x, y));
         let constraints = Constraints::new(&problem.dirichlet, n);
         let system = SystemMatrix::new(disc.pattern.clone(), constraints.mask().to_vec())?;
         let mut v0 = vec![0.0; n];
@@ -326,7 +323,8 @@ impl Stepper {
 
     /// Loads and gravity at time `t` [N].
     fn external_force(&self, t: f64) -> Vec<f64> {
-        let mut f = self.gravity_force.clone();
+        let mut f = vec![0.0; self.state.u.len()];
+        crate::gravity::add_force(&mut f, self.problem.gravity.at(t), &self.gravity_force);
         for load in &self.problem.loads {
             let share = 1.0 / load.nodes.len().max(1) as f64;
             for k in 0..3 {

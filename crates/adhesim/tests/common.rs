@@ -54,7 +54,7 @@ pub fn one_body(
         }],
         dirichlet: vec![],
         loads: vec![],
-        gravity: [0.0; 3],
+        gravity: Default::default(),
         time,
         contacts: vec![],
         tracks: vec![],

@@ -233,7 +233,7 @@ fn indent_with(
             fixed(mesh.node_sets["outer"].clone(), [true, true, true]),
         ],
         loads: vec![],
-        gravity: [0.0; 3],
+        gravity: Default::default(),
         // One quasi-static step: frictionless elastic contact does not depend on the path.
         time: TimeSettings {
             t_end: 1.0,
