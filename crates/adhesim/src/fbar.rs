@@ -49,6 +49,9 @@ pub enum Formulation {
     Standard,
     /// F-bar: the volume change of each Gauss point is the element's mean dilatation (hex8).
     FBar,
+    /// Averaged nodal pressure for the tetrahedra (see [`crate::anp`]) and F-bar for the
+    /// hexahedra of the body; needs an uncoupled (volumetric/isochoric split) material.
+    AveragedNodalPressure,
 }
 
 type Bmat = SMatrix<f64, 6, 3>;
