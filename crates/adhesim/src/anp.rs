@@ -98,7 +98,7 @@ pub fn volume_and_gradient<const N: usize>(
 ) -> Option<(f64, [Vec3; N])> {
     let f = Mat3::identity() + displacement_gradient(gp, u);
     let j = f.determinant();
-    if !(j > 0.0) {
+    if j.is_nan() || j <= 0.0 {
         return None;
     }
     let f_inv_t = f.try_inverse()?.transpose();
@@ -322,11 +322,11 @@ impl NodalPatches {
                     let rank = ranks[r] as usize;
                     r += 1;
                     let hi = pn[j];
-                    for k in 0..3 {
+                    for (k, wjk) in w[j].iter().enumerate() {
                         let base = pattern.col_ptr[3 * hi + k] + 3 * rank;
                         let imax = if i == j { k + 1 } else { 3 };
                         for l in 0..imax {
-                            tangent[base + l] += wi[l] * w[j][k];
+                            tangent[base + l] += wi[l] * wjk;
                         }
                     }
                 }

@@ -91,6 +91,10 @@ pub struct Discretisation {
     pub step_dt: f64,
 }
 
+/// Adds the volumetric part of element `e` to the response of its isochoric part (the
+/// averaged-nodal-pressure tetrahedra).
+type VolumetricPart<'a, const N: usize> = dyn Fn(usize, &mut ElementResponse<N>) + Sync + 'a;
+
 /// Assembled internal force, tangent values (pattern order), energy and min J.
 pub struct Assembled {
     /// Internal force vector [N], 3 per node.
@@ -388,9 +392,9 @@ impl Discretisation {
                         return;
                     };
                     let p = state.element_pressure[e];
-                    for a in 0..4 {
-                        for i in 0..3 {
-                            r.force[a][i] += p * dv[a][i];
+                    for (fa, dva) in r.force.iter_mut().zip(dv) {
+                        for (f, d) in fa.iter_mut().zip(dva.iter()) {
+                            *f += p * d;
                         }
                     }
                     if let Some(k) = r.tangent.as_mut() {
@@ -416,7 +420,7 @@ impl Discretisation {
         u: &[f64],
         out: &mut Assembled,
         with_tangent: bool,
-        volumetric: Option<&(dyn Fn(usize, &mut ElementResponse<N>) + Sync)>,
+        volumetric: Option<&VolumetricPart<'_, N>>,
     ) -> (f64, f64) {
         let fptr = SyncPtr(out.force.as_mut_ptr());
         let kptr = SyncPtr(out.tangent.as_mut_ptr());
