@@ -10,4 +10,4 @@ reps=${2:-7}
 cargo run --release --quiet --example bench_fbar -- "$n" "$reps"
 echo
 cargo test --release --quiet -p adhesim --test hertz_sphere nearly_incompressible -- --nocapture 2>&1 \
-    | grep 'Newton iterations'
+    | grep "Newton iterations"
