@@ -2,7 +2,9 @@
 //! sparsity pattern built once, element colouring so that the scatter runs in parallel
 //! without locks, and the constant mass matrix.
 
-use crate::anp::{add_volume_hessian, has_volumetric_split, IsochoricPart, NodalPatches};
+use crate::anp::{
+    add_volume_hessian, has_volumetric_split, IsochoricPart, NodalPatches, PatchState,
+};
 use crate::element::ElementResponse;
 use crate::element::{
     consistent_mass, element_response_with_history, gauss_point_c, hex8_geometry, tet4_geometry,
@@ -498,6 +500,45 @@ impl Discretisation {
             min_j = min_j.min(j);
         }
         (energy, min_j)
+    }
+
+    /// The volumetric state of the averaged-nodal-pressure tetrahedra at `u` (`None`: there
+    /// are none).
+    pub fn patch_state(&self, u: &[f64]) -> Option<PatchState> {
+        self.patches
+            .as_ref()
+            .map(|p| p.state(&self.tets.nodes, &self.tets.gauss, u))
+    }
+
+    /// Cauchy stress [Pa] and volume ratio of tetrahedron `e` at `u`. For an
+    /// averaged-nodal-pressure tetrahedron (`state` from [`Discretisation::patch_state`]) the
+    /// isochoric stress of its F plus its pressure p̄_e, and the mean J̄_e of its nodes' volume
+    /// ratios; for the others the element's own stress and J.
+    pub fn tet_cauchy_stress(
+        &self,
+        e: usize,
+        u: &[f64],
+        state: Option<&PatchState>,
+    ) -> (crate::Mat3, f64) {
+        let en = &self.tets.nodes[e];
+        let ue = en.map(|n| [u[3 * n], u[3 * n + 1], u[3 * n + 2]]);
+        let mat = &*self.materials[self.tets.body[e]];
+        match (state, &self.patches) {
+            (Some(st), Some(p)) if p.active[e] => {
+                let (iso, _) = crate::element::element_cauchy_stress(
+                    &self.tets.gauss[e],
+                    &ue,
+                    &IsochoricPart(mat),
+                );
+                let j = en
+                    .iter()
+                    .map(|&n| st.nodal_ratio[p.patch_of[n] as usize])
+                    .sum::<f64>()
+                    / 4.0;
+                (iso + crate::Mat3::identity() * st.element_pressure[e], j)
+            }
+            _ => crate::element::element_cauchy_stress(&self.tets.gauss[e], &ue, mat),
+        }
     }
 
     /// Mass matrix values in pattern order [kg], consistent or row-sum lumped, from the
