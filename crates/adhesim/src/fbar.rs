@@ -50,7 +50,8 @@ pub enum Formulation {
     /// F-bar: the volume change of each Gauss point is the element's mean dilatation (hex8).
     FBar,
     /// Averaged nodal pressure for the tetrahedra (see [`crate::anp`]) and F-bar for the
-    /// hexahedra of the body; needs an uncoupled (volumetric/isochoric split) material.
+    /// hexahedra of the body; needs an uncoupled (volumetric/isochoric split) material
+    /// (with another material the tetrahedra stay standard; scenarios refuse it).
     AveragedNodalPressure,
 }
 
