@@ -328,3 +328,37 @@ fn cantilever_3d(ny: usize, element: Formulation, tets: bool) -> f64 {
     let tip = right.iter().map(|&n| s.state.u[3 * n + 1]).sum::<f64>() / right.len() as f64;
     -tip / (1e-3 * l)
 }
+
+#[test]
+fn scenario_key_selects_the_element_and_refuses_materials_without_a_split() {
+    let text = |material: &str| {
+        format!(
+            r#"name = "t"
+[time]
+t_end = 1.0
+dt = 0.5
+mode = "quasi-static"
+[[body]]
+name = "b"
+mesh = {{ generator = "block", size = [1.0, 1.0, 1.0], divisions = [1, 1, 1] }}
+material = {material}
+element = "anp"
+density = 1000.0
+"#
+        )
+    };
+    let path = std::path::Path::new("anp.toml");
+    let ok = adhesim::scenario::parse(
+        &text(r#"{ model = "mooney-rivlin", c10 = 0.3e6, c01 = 0.1e6, kappa = 1e9 }"#),
+        path,
+    )
+    .expect("a valid scenario");
+    assert_eq!(ok.bodies[0].element, ANP);
+    let err = adhesim::scenario::parse(&text(r#"{ model = "blatz-ko", g = 1e6 }"#), path)
+        .expect_err("Blatz-Ko has no volumetric split")
+        .to_string();
+    assert!(
+        err.contains("element") && err.contains("uncoupled-neo-hookean"),
+        "{err}"
+    );
+}
