@@ -106,10 +106,10 @@ fn check_derivatives(material: Arc<dyn Hyperelastic>) {
         e[j] = 1.0;
         let mut col = vec![0.0; n];
         disc.pattern.symmetric_matvec(&a.tangent, &e, &mut col);
-        for i in 0..n {
+        for (i, k) in col.iter().enumerate() {
             let fd = (ap.force[i] - am.force[i]) / (2.0 * h);
-            kmax = kmax.max(col[i].abs());
-            worst_k = worst_k.max((fd - col[i]).abs());
+            kmax = kmax.max(k.abs());
+            worst_k = worst_k.max((fd - k).abs());
         }
     }
     eprintln!(
@@ -155,9 +155,8 @@ fn patch_reproduces_a_large_homogeneous_deformation() {
     let s = solve(p);
     let mut err: f64 = 0.0;
     for (i, &x) in mesh.nodes.iter().enumerate() {
-        let ue = field(x);
-        for k in 0..3 {
-            err = err.max((s.state.u[3 * i + k] - ue[k]).abs());
+        for (k, uk) in field(x).iter().enumerate() {
+            err = err.max((s.state.u[3 * i + k] - uk).abs());
         }
     }
     // Newton stops at a relative residual of 1e-12; displacements are ~0.3 m.
