@@ -3,10 +3,14 @@
 //! finite displacement field:
 //!
 //! 1. one element's `element_response` / `fbar_element_response` with tangent (µs);
-//! 2. `Discretisation::assemble(u, true)` on one thread, per element (µs).
+//! 2. `Discretisation::assemble(u, true)` on one thread, per element (µs);
+//! 3. the same for the cube split into tetrahedra, linear tet4 against the
+//!    averaged-nodal-pressure tetrahedron, and the sizes of their sparsity patterns.
 //!
-//! Each timing: one warm-up run, then `reps` runs; the median is reported with the ratio
-//! F-bar / standard. Usage: `cargo run --release --example bench_fbar -- [n] [reps]`.
+//! The two formulations are timed alternately (standard, F-bar, standard, F-bar, ...) after
+//! one warm-up run of each, so that both see the same machine load; reported are the median
+//! of each, the ratio of the medians and the median of the per-pair ratios.
+//! Usage: `cargo run --release --example bench_fbar -- [n] [reps]`.
 
 use adhesim::assembly::Discretisation;
 use adhesim::element::{element_response, hex8_geometry};
@@ -27,17 +31,31 @@ fn displacement(x: [f64; 3]) -> [f64; 3] {
     ]
 }
 
-fn median(reps: usize, mut f: impl FnMut()) -> f64 {
+fn time(f: &mut impl FnMut()) -> f64 {
+    let t0 = Instant::now();
     f();
-    let mut t: Vec<f64> = (0..reps)
-        .map(|_| {
-            let t0 = Instant::now();
-            f();
-            t0.elapsed().as_secs_f64()
-        })
-        .collect();
-    t.sort_by(f64::total_cmp);
-    t[reps / 2]
+    t0.elapsed().as_secs_f64()
+}
+
+fn median_of(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Alternating timings of `a` and `b` after one warm-up of each: (median a, median b,
+/// median of the per-pair ratios b/a) [s].
+fn alternate(reps: usize, mut a: impl FnMut(), mut b: impl FnMut()) -> (f64, f64, f64) {
+    a();
+    b();
+    let (mut ta, mut tb, mut r) = (vec![], vec![], vec![]);
+    for _ in 0..reps {
+        let x = time(&mut a);
+        let y = time(&mut b);
+        ta.push(x);
+        tb.push(y);
+        r.push(y / x);
+    }
+    (median_of(ta), median_of(tb), median_of(r))
 }
 
 fn main() {
@@ -57,21 +75,25 @@ fn main() {
     let ue: [[f64; 3]; 8] = std::array::from_fn(|a| displacement(x[a]));
     let iters = 20_000;
     let mat = &*material;
-    let standard_el = median(reps, || {
-        for _ in 0..iters {
-            black_box(element_response(black_box(&gps), black_box(&ue), mat, true));
-        }
-    }) / iters as f64;
-    let fbar_el = median(reps, || {
-        for _ in 0..iters {
-            black_box(fbar_element_response(
-                black_box(&gps),
-                black_box(&ue),
-                mat,
-                true,
-            ));
-        }
-    }) / iters as f64;
+    let (standard_el, fbar_el, el_ratio) = alternate(
+        reps,
+        || {
+            for _ in 0..iters {
+                black_box(element_response(black_box(&gps), black_box(&ue), mat, true));
+            }
+        },
+        || {
+            for _ in 0..iters {
+                black_box(fbar_element_response(
+                    black_box(&gps),
+                    black_box(&ue),
+                    mat,
+                    true,
+                ));
+            }
+        },
+    );
+    let (standard_el, fbar_el) = (standard_el / iters as f64, fbar_el / iters as f64);
 
     // 2. Assembly of an n³ cube on one thread.
     let mesh = generate::block([1.0, 1.0, 1.0], [n, n, n]);
@@ -80,27 +102,70 @@ fn main() {
         .num_threads(1)
         .build()
         .expect("thread pool");
-    let assemble = |f: Formulation| {
-        let disc = Discretisation::with_formulations(&[(&mesh, material.clone())], &[f])
-            .expect("valid mesh");
-        pool.install(|| median(reps, || drop(black_box(disc.assemble(black_box(&u), true)))))
-            / mesh.hexes.len() as f64
+    let disc = |f: Formulation| {
+        Discretisation::with_formulations(&[(&mesh, material.clone())], &[f]).expect("valid mesh")
     };
-    let standard_asm = assemble(Formulation::Standard);
-    let fbar_asm = assemble(Formulation::FBar);
+    let (standard, fbar) = (disc(Formulation::Standard), disc(Formulation::FBar));
+    let ne = mesh.hexes.len() as f64;
+    let (standard_asm, fbar_asm, asm_ratio) = pool.install(|| {
+        alternate(
+            reps,
+            || drop(black_box(standard.assemble(black_box(&u), true))),
+            || drop(black_box(fbar.assemble(black_box(&u), true))),
+        )
+    });
+    let (standard_asm, fbar_asm) = (standard_asm / ne, fbar_asm / ne);
 
-    println!("| measurement | standard hex8 [µs] | F-bar hex8 [µs] | ratio |");
-    println!("|---|---|---|---|");
+    println!("| measurement | standard hex8 [µs] | F-bar hex8 [µs] | ratio of medians | median of pair ratios |");
+    println!("|---|---|---|---|---|");
     println!(
-        "| element response with tangent | {:.2} | {:.2} | {:.2} |",
+        "| element response with tangent | {:.2} | {:.2} | {:.2} | {:.2} |",
         standard_el * 1e6,
         fbar_el * 1e6,
-        fbar_el / standard_el
+        fbar_el / standard_el,
+        el_ratio
     );
     println!(
-        "| assembly K + f per element, {n}³ cube, 1 thread | {:.2} | {:.2} | {:.2} |",
+        "| assembly K + f per element, {n}³ cube, 1 thread | {:.2} | {:.2} | {:.2} | {:.2} |",
         standard_asm * 1e6,
         fbar_asm * 1e6,
-        fbar_asm / standard_asm
+        fbar_asm / standard_asm,
+        asm_ratio
+    );
+
+    // 3. The same cube split into tetrahedra: linear tet4 against the averaged-nodal-pressure
+    // tetrahedron (whose patches widen the pattern), per tetrahedron.
+    let tets = mesh.split_hexes_into_tets();
+    let u: Vec<f64> = tets.nodes.iter().flat_map(|&p| displacement(p)).collect();
+    let tdisc = |f: Formulation| {
+        Discretisation::with_formulations(&[(&tets, material.clone())], &[f]).expect("valid mesh")
+    };
+    let (linear, anp) = (
+        tdisc(Formulation::Standard),
+        tdisc(Formulation::AveragedNodalPressure),
+    );
+    let nt = tets.tets.len() as f64;
+    let (linear_asm, anp_asm, tet_ratio) = pool.install(|| {
+        alternate(
+            reps,
+            || drop(black_box(linear.assemble(black_box(&u), true))),
+            || drop(black_box(anp.assemble(black_box(&u), true))),
+        )
+    });
+    println!();
+    println!("| measurement | linear tet4 [µs] | averaged nodal pressure tet4 [µs] | ratio of medians | median of pair ratios |");
+    println!("|---|---|---|---|---|");
+    println!(
+        "| assembly K + f per tetrahedron, {n}³ cube × 6, 1 thread | {:.2} | {:.2} | {:.2} | {:.2} |",
+        linear_asm / nt * 1e6,
+        anp_asm / nt * 1e6,
+        anp_asm / linear_asm,
+        tet_ratio
+    );
+    println!(
+        "| stored tangent values | {} | {} | {:.2} | |",
+        linear.pattern.nnz(),
+        anp.pattern.nnz(),
+        anp.pattern.nnz() as f64 / linear.pattern.nnz() as f64
     );
 }

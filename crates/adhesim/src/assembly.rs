@@ -2,6 +2,10 @@
 //! sparsity pattern built once, element colouring so that the scatter runs in parallel
 //! without locks, and the constant mass matrix.
 
+use crate::anp::{
+    add_volume_hessian, has_volumetric_split, IsochoricPart, NodalPatches, PatchState,
+};
+use crate::element::ElementResponse;
 use crate::element::{
     consistent_mass, element_response_with_history, gauss_point_c, hex8_geometry, tet4_geometry,
     DegenerateElement, GaussPoint,
@@ -21,7 +25,8 @@ pub struct ElementBlock<const N: usize, const G: usize> {
     pub gauss: Vec<[GaussPoint<N>; G]>,
     /// Index of the owning body.
     pub body: Vec<usize>,
-    /// True for F-bar elements, false for the standard fully integrated ones.
+    /// True for F-bar hexahedra and averaged-nodal-pressure tetrahedra ([`crate::anp`]),
+    /// false for the standard fully integrated elements.
     pub fbar: Vec<bool>,
     /// Committed internal variables of viscoelastic elements, all Gauss points one after the
     /// other (empty for elastic elements).
@@ -80,11 +85,17 @@ pub struct Discretisation {
     pub hexes: ElementBlock<8, 8>,
     /// Tetrahedra.
     pub tets: ElementBlock<4, 1>,
+    /// Nodal patches of the averaged-nodal-pressure tetrahedra (`None`: there are none).
+    pub patches: Option<NodalPatches>,
     /// Upper-triangle block pattern of every system matrix.
     pub pattern: BlockPattern,
     /// Size of the step being solved [s], for the viscoelastic materials.
     pub step_dt: f64,
 }
+
+/// Adds the volumetric part of element `e` to the response of its isochoric part (the
+/// averaged-nodal-pressure tetrahedra).
+type VolumetricPart<'a, const N: usize> = dyn Fn(usize, &mut ElementResponse<N>) + Sync + 'a;
 
 /// Assembled internal force, tangent values (pattern order), energy and min J.
 pub struct Assembled {
@@ -222,7 +233,13 @@ impl Discretisation {
             let off = reference.len();
             node_offset.push(off);
             reference.extend_from_slice(&mesh.nodes);
-            let fbar = formulations.get(bi) == Some(&Formulation::FBar);
+            let formulation = formulations.get(bi).copied().unwrap_or_default();
+            let fbar = matches!(
+                formulation,
+                Formulation::FBar | Formulation::AveragedNodalPressure
+            );
+            let anp = formulation == Formulation::AveragedNodalPressure
+                && has_volumetric_split(&*bodies[bi].1);
             for (ci, h) in mesh.hexes.iter().enumerate() {
                 let x = h.map(|n| mesh.nodes[n]);
                 match hex8_geometry(&x) {
@@ -247,7 +264,7 @@ impl Discretisation {
                         tets.nodes.push(t.map(|n| n + off));
                         tets.gauss.push(g);
                         tets.body.push(bi);
-                        tets.fbar.push(false);
+                        tets.fbar.push(anp);
                         tets.history.push(history_for(&*bodies[bi].1, 1));
                     }
                     Err(DegenerateElement { det }) => bad.push(BadElement {
@@ -262,16 +279,29 @@ impl Discretisation {
             return Err(bad);
         }
         let num_nodes = reference.len();
+        let mut patches = tets.fbar.iter().any(|&a| a).then(|| {
+            let volume: Vec<f64> = tets.gauss.iter().map(|g| g[0].weight).collect();
+            let kappa: Vec<f64> = tets
+                .body
+                .iter()
+                .map(|&b| bodies[b].1.bulk_modulus())
+                .collect();
+            NodalPatches::new(&tets.nodes, &volume, &kappa, tets.fbar.clone(), num_nodes)
+        });
         let pattern = BlockPattern::from_cells(
             num_nodes,
             hexes
                 .nodes
                 .iter()
                 .map(|c| &c[..])
-                .chain(tets.nodes.iter().map(|c| &c[..])),
+                .chain(tets.nodes.iter().map(|c| &c[..]))
+                .chain(patches.iter().flat_map(|p| p.cells())),
         );
         fill_ranks(&mut hexes, &pattern);
         fill_ranks(&mut tets, &pattern);
+        if let Some(p) = patches.as_mut() {
+            p.fill_ranks(&pattern);
+        }
         let materials = bodies.iter().map(|(_, m)| m.clone()).collect();
         Ok(Discretisation {
             node_offset,
@@ -280,6 +310,7 @@ impl Discretisation {
             materials,
             hexes,
             tets,
+            patches,
             pattern,
             step_dt: 0.0,
         })
@@ -352,8 +383,34 @@ impl Discretisation {
             energy: 0.0,
             min_j: f64::INFINITY,
         };
-        let (e1, j1) = self.assemble_block(&self.hexes, u, &mut out, with_tangent);
-        let (e2, j2) = self.assemble_block(&self.tets, u, &mut out, with_tangent);
+        let (e1, j1) = self.assemble_block(&self.hexes, u, &mut out, with_tangent, None);
+        let (e2, j2) = match &self.patches {
+            None => self.assemble_block(&self.tets, u, &mut out, with_tangent, None),
+            Some(patches) => {
+                let state = patches.state(&self.tets.nodes, &self.tets.gauss, u);
+                // The volumetric part of each element: p̄_e ∂v_e/∂u and p̄_e ∂²v_e/∂u².
+                let add_pressure = |e: usize, r: &mut ElementResponse<4>| {
+                    let Some((v, dv)) = &state.volume[e] else {
+                        return;
+                    };
+                    let p = state.element_pressure[e];
+                    for (fa, dva) in r.force.iter_mut().zip(dv) {
+                        for (f, d) in fa.iter_mut().zip(dva.iter()) {
+                            *f += p * d;
+                        }
+                    }
+                    if let Some(k) = r.tangent.as_mut() {
+                        add_volume_hessian(k, dv, *v, p);
+                    }
+                };
+                let (e, j) =
+                    self.assemble_block(&self.tets, u, &mut out, with_tangent, Some(&add_pressure));
+                if with_tangent {
+                    patches.add_patch_tangent(&state, &self.pattern, &mut out.tangent);
+                }
+                (e + state.energy, j)
+            }
+        };
         out.energy = e1 + e2;
         out.min_j = j1.min(j2);
         out
@@ -365,6 +422,7 @@ impl Discretisation {
         u: &[f64],
         out: &mut Assembled,
         with_tangent: bool,
+        volumetric: Option<&VolumetricPart<'_, N>>,
     ) -> (f64, f64) {
         let fptr = SyncPtr(out.force.as_mut_ptr());
         let kptr = SyncPtr(out.tangent.as_mut_ptr());
@@ -384,7 +442,18 @@ impl Discretisation {
                     let mat = &*self.materials[block.body[e]];
                     let hist = (!block.history[e].is_empty())
                         .then(|| (&block.history[e][..], self.step_dt));
-                    let r = if block.fbar[e] {
+                    let r = if let (true, Some(add)) = (block.fbar[e], volumetric) {
+                        let iso = IsochoricPart(mat);
+                        let mut r = element_response_with_history(
+                            &block.gauss[e],
+                            &ue,
+                            &iso,
+                            with_tangent,
+                            hist,
+                        );
+                        add(e, &mut r);
+                        r
+                    } else if block.fbar[e] {
                         fbar_element_response_with_history(
                             &block.gauss[e],
                             &ue,
@@ -431,6 +500,45 @@ impl Discretisation {
             min_j = min_j.min(j);
         }
         (energy, min_j)
+    }
+
+    /// The volumetric state of the averaged-nodal-pressure tetrahedra at `u` (`None`: there
+    /// are none).
+    pub fn patch_state(&self, u: &[f64]) -> Option<PatchState> {
+        self.patches
+            .as_ref()
+            .map(|p| p.state(&self.tets.nodes, &self.tets.gauss, u))
+    }
+
+    /// Cauchy stress [Pa] and volume ratio of tetrahedron `e` at `u`. For an
+    /// averaged-nodal-pressure tetrahedron (`state` from [`Discretisation::patch_state`]) the
+    /// isochoric stress of its F plus its pressure p̄_e, and the mean J̄_e of its nodes' volume
+    /// ratios; for the others the element's own stress and J.
+    pub fn tet_cauchy_stress(
+        &self,
+        e: usize,
+        u: &[f64],
+        state: Option<&PatchState>,
+    ) -> (crate::Mat3, f64) {
+        let en = &self.tets.nodes[e];
+        let ue = en.map(|n| [u[3 * n], u[3 * n + 1], u[3 * n + 2]]);
+        let mat = &*self.materials[self.tets.body[e]];
+        match (state, &self.patches) {
+            (Some(st), Some(p)) if p.active[e] => {
+                let (iso, _) = crate::element::element_cauchy_stress(
+                    &self.tets.gauss[e],
+                    &ue,
+                    &IsochoricPart(mat),
+                );
+                let j = en
+                    .iter()
+                    .map(|&n| st.nodal_ratio[p.patch_of[n] as usize])
+                    .sum::<f64>()
+                    / 4.0;
+                (iso + crate::Mat3::identity() * st.element_pressure[e], j)
+            }
+            _ => crate::element::element_cauchy_stress(&self.tets.gauss[e], &ue, mat),
+        }
     }
 
     /// Mass matrix values in pattern order [kg], consistent or row-sum lumped, from the

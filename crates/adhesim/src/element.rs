@@ -206,6 +206,33 @@ pub fn displacement_gradient<const N: usize>(gp: &GaussPoint<N>, u: &[[f64; 3]; 
     h
 }
 
+/// The committed internal variables of an element's Gauss points and the step size Δt [s],
+/// with the viscoelastic model they belong to.
+pub(crate) type ViscousHistory<'a> = Option<((&'a [f64], f64), &'a crate::material::Viscoelastic)>;
+
+/// The material at one Gauss point `q` of an element, shared by all element kernels: the
+/// energy W(C) [J/m³], the stress S [Pa] and, when `with_tangent`, the tangent D [Pa], with
+/// the viscous part of that point when `viscous` holds the element's history.
+pub(crate) fn material_point(
+    material: &dyn Hyperelastic,
+    c: &Mat3,
+    q: usize,
+    viscous: ViscousHistory<'_>,
+    with_tangent: bool,
+) -> (f64, Mat3, Option<crate::Mat6>) {
+    let (mut s, mut d) = if with_tangent {
+        let (s, d) = material.pk2_and_tangent(c);
+        (s, Some(d))
+    } else {
+        (material.pk2(c), None)
+    };
+    if let Some(((hist, dt), ve)) = viscous {
+        let len = ve.history_len();
+        ve.add_viscous(c, &hist[q * len..(q + 1) * len], dt, &mut s, d.as_mut());
+    }
+    (material.energy(c), s, d)
+}
+
 /// Internal force, (optionally) tangent, energy and min J of one element.
 ///
 /// Finite-strain materials use F = I + H, C = FᵀF; a small-strain material gets
@@ -253,19 +280,10 @@ pub fn element_response_with_history<const N: usize, const G: usize>(
             energy = f64::NAN;
             continue;
         }
-        energy += material.energy(&c) * gp.weight;
+        let (w_point, s, d) = material_point(material, &c, q, viscous, with_tangent);
+        energy += w_point * gp.weight;
         let w = gp.weight;
         let bs: [Bmat; N] = std::array::from_fn(|a| b_matrix(&fb, &gp.grad[a]));
-        let (mut s, mut d) = if with_tangent {
-            let (s, d) = material.pk2_and_tangent(&c);
-            (s, Some(d))
-        } else {
-            (material.pk2(&c), None)
-        };
-        if let Some(((hist, dt), ve)) = viscous {
-            let len = ve.history_len();
-            ve.add_viscous(&c, &hist[q * len..(q + 1) * len], dt, &mut s, d.as_mut());
-        }
         let sv = nalgebra::Vector6::new(
             s[(0, 0)],
             s[(1, 1)],

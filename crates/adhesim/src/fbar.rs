@@ -36,7 +36,7 @@
 //! 𝔸[F] = F̄ (S + ℂ:C̄) / α, m_a = 𝔸[F] G_a, and L_ab = ∂²(ln θ)/∂u_a∂u_b
 //! = (1/(θV)) Σ_g w_g J_g (g_a ⊗ g_b − g_b ⊗ g_a) − d_a ⊗ d_b / θ².
 
-use crate::element::{displacement_gradient, ElementResponse, GaussPoint};
+use crate::element::{displacement_gradient, material_point, ElementResponse, GaussPoint};
 use crate::material::Hyperelastic;
 use crate::{Mat3, Vec3};
 use nalgebra::{SMatrix, Vector6};
@@ -49,6 +49,10 @@ pub enum Formulation {
     Standard,
     /// F-bar: the volume change of each Gauss point is the element's mean dilatation (hex8).
     FBar,
+    /// Averaged nodal pressure for the tetrahedra (see [`crate::anp`]) and F-bar for the
+    /// hexahedra of the body; needs an uncoupled (volumetric/isochoric split) material
+    /// (with another material the tetrahedra stay standard; scenarios refuse it).
+    AveragedNodalPressure,
 }
 
 type Bmat = SMatrix<f64, 6, 3>;
@@ -166,23 +170,8 @@ pub fn fbar_element_response_with_history<const N: usize, const G: usize>(
         let fbar = f * alpha;
         let w = gp.weight;
         let cbar = fbar.transpose() * fbar;
-        energy += material.energy(&cbar) * w;
-        let (mut s, mut dmat) = if with_tangent {
-            let (s, d) = material.pk2_and_tangent(&cbar);
-            (s, Some(d))
-        } else {
-            (material.pk2(&cbar), None)
-        };
-        if let Some(((hist, dt), ve)) = viscous {
-            let len = ve.history_len();
-            ve.add_viscous(
-                &cbar,
-                &hist[q * len..(q + 1) * len],
-                dt,
-                &mut s,
-                dmat.as_mut(),
-            );
-        }
+        let (w_point, s, dmat) = material_point(material, &cbar, q, viscous, with_tangent);
+        energy += w_point * w;
         let p = fbar * s;
         let pf = p.dot(&f);
         let grads: [Vec3; N] = std::array::from_fn(|a| Vec3::from(gp.grad[a]));

@@ -7,6 +7,7 @@
 //!
 //! Units are SI throughout (m, kg, s, N, Pa).
 
+pub mod anp;
 pub mod assembly;
 pub mod checkpoint;
 pub mod contact;

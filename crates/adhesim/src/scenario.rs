@@ -503,9 +503,17 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
                 }
                 crate::fbar::Formulation::FBar
             }
+            Some("anp") => {
+                if !crate::anp::has_volumetric_split(&*material) {
+                    return Err(ctx.err(format!(
+                        "`{key}.element` = \"anp\" needs a material with a bulk modulus split off: \"uncoupled-neo-hookean\", \"mooney-rivlin\" or \"ogden\" (optionally viscoelastic)"
+                    )));
+                }
+                crate::fbar::Formulation::AveragedNodalPressure
+            }
             Some(other) => {
                 return Err(ctx.err(format!(
-                    "`{key}.element` = {other:?}; valid values are \"standard\" (full integration) and \"fbar\" (locking-free hexahedra)"
+                    "`{key}.element` = {other:?}; valid values are \"standard\" (full integration), \"fbar\" (locking-free hexahedra) and \"anp\" (locking-free tetrahedra by averaged nodal pressure, F-bar hexahedra)"
                 )))
             }
         };

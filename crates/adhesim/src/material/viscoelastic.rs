@@ -117,6 +117,9 @@ impl Hyperelastic for Viscoelastic {
     fn bulk_modulus(&self) -> f64 {
         self.elastic.bulk_modulus()
     }
+    fn isochoric_pk2_and_tangent(&self, c: &Mat3) -> Option<(Mat3, Mat6)> {
+        self.elastic.isochoric_pk2_and_tangent(c)
+    }
     fn viscoelastic(&self) -> Option<&Viscoelastic> {
         Some(self)
     }

@@ -124,6 +124,76 @@ impl Mesh {
     }
 }
 
+/// Hex8 node (VTK order) at each corner of the unit cube, indexed by x + 2y + 4z.
+const HEX_CORNER: [usize; 8] = [0, 1, 3, 2, 4, 5, 7, 6];
+
+impl Mesh {
+    /// The same body with each hexahedron split into six tetrahedra around its diagonal from
+    /// node 0 to node 6 (one tetrahedron per ordering of the three natural axes). Each quad
+    /// face is then cut along its diagonal from the corner of lowest to the corner of highest
+    /// natural coordinates, so neighbouring hexahedra whose natural axes point the same way
+    /// (the structured meshes of [`generate`]) stay conforming. Tetrahedra are kept, node and
+    /// face sets carried over (each quad of a face set becomes its two triangles).
+    pub fn split_hexes_into_tets(&self) -> Mesh {
+        let mut out = Mesh {
+            nodes: self.nodes.clone(),
+            tets: self.tets.clone(),
+            node_sets: self.node_sets.clone(),
+            ..Default::default()
+        };
+        let perms = [
+            [0, 1, 2],
+            [0, 2, 1],
+            [1, 0, 2],
+            [1, 2, 0],
+            [2, 0, 1],
+            [2, 1, 0],
+        ];
+        for h in &self.hexes {
+            for p in perms {
+                let c1 = 1 << p[0];
+                let c2 = c1 | (1 << p[1]);
+                let mut t = [h[HEX_CORNER[0]], h[HEX_CORNER[c1]], h[HEX_CORNER[c2]], h[6]];
+                let x = t.map(|n| self.nodes[n]);
+                let d = |a: usize| std::array::from_fn::<f64, 3, _>(|k| x[a][k] - x[0][k]);
+                let (a, b, c) = (d(1), d(2), d(3));
+                let vol = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                    + a[2] * (b[0] * c[1] - b[1] * c[0]);
+                if vol < 0.0 {
+                    t.swap(1, 2);
+                }
+                out.tets.push(t);
+            }
+        }
+        let boundary: std::collections::HashMap<Vec<usize>, Face> = out
+            .cell_faces()
+            .into_iter()
+            .filter(|(_, (n, _))| *n == 1)
+            .map(|(k, (_, f))| (k, f))
+            .collect();
+        for (name, faces) in &self.face_sets {
+            let mut tris = Vec::new();
+            for f in faces {
+                match f {
+                    Face::Tri(_) => tris.push(*f),
+                    Face::Quad(q) => {
+                        for skip in 0..4 {
+                            let mut key: Vec<usize> =
+                                (0..4).filter(|&i| i != skip).map(|i| q[i]).collect();
+                            key.sort_unstable();
+                            if let Some(t) = boundary.get(&key) {
+                                tris.push(*t);
+                            }
+                        }
+                    }
+                }
+            }
+            out.face_sets.insert(name.clone(), tris);
+        }
+        out
+    }
+}
+
 /// Local node indices of the six faces of a hex8 (VTK order), outward oriented.
 pub const HEX_FACES: [[usize; 4]; 6] = [
     [0, 3, 2, 1], // ζ = −1

@@ -159,6 +159,7 @@ fn body_frames(view: &StepView) -> Vec<BodyFrame> {
     let (u, v) = (&view.state.u, &view.state.v);
     let offsets = &disc.node_offset;
     let mut out = Vec::new();
+    let patches = disc.patch_state(u);
     for (bi, body) in view.problem.bodies.iter().enumerate() {
         let off = offsets[bi];
         let nn = body.mesh.num_nodes();
@@ -202,8 +203,7 @@ fn body_frames(view: &StepView) -> Vec<BodyFrame> {
         }
         for e in 0..disc.tets.len() {
             if disc.tets.body[e] == bi {
-                let ue = disc.tets.nodes[e].map(|n| [u[3 * n], u[3 * n + 1], u[3 * n + 2]]);
-                let (s, j) = element_cauchy_stress(&disc.tets.gauss[e], &ue, mat);
+                let (s, j) = disc.tet_cauchy_stress(e, u, patches.as_ref());
                 push(s, j);
             }
         }
