@@ -12,20 +12,22 @@ mod coupling;
 mod delassus_coupling;
 mod integrator;
 mod newton_coupling;
+mod newton_loop;
 
 pub use constraints::Constraints;
 
-use crate::assembly::{Assembled, BadElement, Discretisation};
+use crate::assembly::{BadElement, Discretisation};
 use crate::contact::anisotropic::align_frames;
 use crate::contact::detect::{detect, ContactPoint};
 use crate::contact::law::{accumulated_damage, BondState, ContactState, PointSolution};
 use crate::linalg::LinalgError;
 use crate::problem::{ContactSolver, Problem};
 use crate::system::SystemMatrix;
-use coupling::{Candidates, ContactCoupling, Evaluated, Iterate, StepContact};
+use coupling::{Candidates, ContactCoupling, StepContact};
 use delassus_coupling::{DelassusCache, DelassusCoupling};
-use integrator::{norm, Inertia, Scheme, ThetaStep, Workspace};
+use integrator::{Inertia, Scheme, ThetaStep, Workspace};
 use newton_coupling::NewtonCoupling;
+use newton_loop::{Flow, NewtonLoop};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -378,7 +380,7 @@ impl Stepper {
                 "contact state has {got:?} slave nodes per pair but the problem has {sizes:?}"
             ));
         }
-        if !(snap.dt > 0.0) || !snap.t.is_finite() {
+        if snap.dt.is_nan() || snap.dt <= 0.0 || !snap.t.is_finite() {
             return Err(format!("invalid time {} or step size {}", snap.t, snap.dt));
         }
         self.disc.set_history(&snap.material_history)?;
@@ -593,28 +595,27 @@ impl Stepper {
     }
 
     /// One Newton solve over [t, t+dt]; Err with the reason on failure. The stages follow
-    /// docs/model.md §3: detect, predict, then per iteration assemble, evaluate the contact
-    /// law, check convergence, factorise K̄ and solve the correction, solve the contact
-    /// problem, update.
+    /// docs/model.md §3: detect the contact candidates, predict, then iterate (assemble,
+    /// evaluate the contact law, check, factorise and solve, solve the contact problem,
+    /// update) until the iterate converges.
     fn attempt(&mut self, dt: f64) -> Result<Attempt, String> {
         self.disc.begin_step(dt);
-        let (ts, t1) = (&self.problem.time, self.state.t + dt);
+        let (settings, t1) = (&self.problem.time, self.state.t + dt);
         let f_ext1 = self.external_force(t1);
-        let mut timings = PhaseTimes::default();
         let clock = Instant::now();
         let candidates = self.detect_contact(t1);
         let laws = self.problem.contacts.iter().map(|c| c.law).collect();
-        let (contact, lambda) = StepContact::new(
-            candidates,
-            laws,
-            dt,
-            &self.disc.reference,
-            &self.constraints,
-        );
-        let mut coupling = couple(contact, lambda, &mut self.system, &mut self.delassus_cache)?;
-        timings.delassus += clock.elapsed().as_secs_f64();
+        let reference = &self.disc.reference;
+        let (contact, lambda) =
+            StepContact::new(candidates, laws, dt, reference, &self.constraints);
+        let system = &mut self.system;
+        let coupling: Box<dyn ContactCoupling<'_> + '_> = match lambda {
+            Some(lambda) => Box::new(NewtonCoupling::new(contact, lambda, system)?),
+            None => Box::new(DelassusCoupling::new(contact, &mut self.delassus_cache)),
+        };
+        let detect_time = clock.elapsed().as_secs_f64();
         let step = ThetaStep::new(
-            &Scheme::of(ts),
+            &Scheme::of(settings),
             dt,
             (&self.state.u, &self.state.v),
             (&self.f_ext0, &self.f_int0),
@@ -623,79 +624,25 @@ impl Stepper {
             &self.disc.pattern,
         );
         let ws = &mut self.workspace;
-        let mut u = step.predict(ws);
-        self.constraints.impose(&self.disc.reference, t1, &mut u);
-        let (mut negligible, mut last_rel, mut contact_residual) = (false, f64::NAN, 0.0);
-        for iter in 1..=ts.max_newton {
-            let asm = assemble(&self.disc, &u, iter, &mut timings)?;
-            let balance = step.balance(&u, &asm.force, asm.energy, ws);
-            if iter == 1 {
-                coupling
-                    .step_contact()
-                    .set_augmentation(|| step.matrix_diagonal(&asm.tangent));
+        let (disc, constraints) = (&self.disc, &self.constraints);
+        let mut newton = NewtonLoop::new(
+            step,
+            coupling,
+            system,
+            disc,
+            constraints,
+            ws,
+            settings,
+            self.model_size,
+        );
+        newton.timings.delassus += detect_time;
+        let mut u = newton.predict(t1);
+        for iter in 1..=settings.max_newton {
+            if let Flow::Converged(attempt) = newton.iterate(iter, &mut u)? {
+                return Ok(*attempt);
             }
-            let it = Iterate::new(iter, &ws.g, balance.potential);
-            if let Evaluated::Backtracked = coupling.evaluate(&it, &mut u, &mut timings) {
-                continue;
-            }
-            let scale = balance.scale.max(coupling.step_contact().bond_strength);
-            let check = check_balance(
-                &mut ws.g,
-                coupling.contact_force(),
-                &self.constraints,
-                scale,
-                iter,
-            )?;
-            last_rel = check.relative;
-            contact_residual = coupling.contact_residual(check.scale);
-            let contact_solved = coupling.step_contact().is_empty()
-                || (iter > 1 && contact_residual <= ts.contact_tol);
-            if contact_solved && check.converged(ts.newton_tol, negligible) {
-                return Ok(finish(
-                    &step,
-                    u,
-                    asm,
-                    check,
-                    coupling,
-                    contact_residual,
-                    &ws.v1,
-                    timings,
-                ));
-            }
-            if iter == ts.max_newton {
-                break;
-            }
-            let mut du = newton_correction(
-                &mut self.system,
-                &step,
-                &asm.tangent,
-                coupling.as_ref(),
-                &ws.g,
-                iter,
-                &mut timings,
-            )?;
-            let it = Iterate::new(iter, &ws.g, balance.potential);
-            coupling.correct(
-                &it,
-                &u,
-                &mut du,
-                check.norm,
-                check.scale,
-                &mut self.system,
-                &mut timings,
-            )?;
-            for (ui, di) in u.iter_mut().zip(&du) {
-                *ui += di;
-            }
-            // The floor (1e-6 of the model size) covers steps in which nothing moves.
-            negligible =
-                norm(&du) <= ts.newton_tol * step.increment(&u).max(1e-6 * self.model_size);
         }
-        coupling.abandon();
-        Err(format!(
-            "Newton did not converge in {} iterations (residual {last_rel:.2e}, contact residual {contact_residual:.2e})",
-            ts.max_newton
-        ))
+        Err(newton.failure())
     }
 
     /// Stage *detect*: the contact candidates over [t, t1] with their committed bond state,
@@ -732,156 +679,4 @@ impl Stepper {
             bond_strength,
         }
     }
-}
-
-/// The contact solve of the step: the Newton solve when `lambda` (its starting multipliers)
-/// is given, Gauss-Seidel on the Delassus operator otherwise.
-fn couple<'a>(
-    contact: StepContact<'a>,
-    lambda: Option<Vec<[f64; 3]>>,
-    system: &mut SystemMatrix,
-    delassus_cache: &'a mut DelassusCache,
-) -> Result<Box<dyn ContactCoupling<'a> + 'a>, String> {
-    Ok(match lambda {
-        Some(lambda) => Box::new(NewtonCoupling::new(contact, lambda, system)?),
-        None => Box::new(DelassusCoupling::new(contact, delassus_cache)),
-    })
-}
-
-/// Stage *factorise and solve*: K̄ = c_stiff K + c_damp A + c_mass M (+ the contact law's
-/// stiffness) and the correction against the residual with the current contact forces Hᵀr.
-/// The Gauss-Seidel solve then adds K̄⁻¹Hᵀ(r − r_prev): at a converged iterate r = r_prev and
-/// G(u) = Hᵀr whatever W was used, so W may be reused from an earlier iteration or step (it
-/// then only slows the convergence).
-fn newton_correction(
-    system: &mut SystemMatrix,
-    step: &ThetaStep,
-    tangent: &[f64],
-    coupling: &dyn ContactCoupling<'_>,
-    g: &[f64],
-    iter: usize,
-    timings: &mut PhaseTimes,
-) -> Result<Vec<f64>, String> {
-    let clock = Instant::now();
-    system.set_from_base(&step.matrix_terms(tangent));
-    coupling.add_tangent(system);
-    system
-        .factorise()
-        .map_err(|e| format!("{e} (Newton iteration {iter})"))?;
-    let mut du: Vec<f64> = coupling
-        .contact_force()
-        .iter()
-        .zip(g)
-        .map(|(r, g)| r - g)
-        .collect();
-    system.solve_in_place(&mut du);
-    timings.factorisation += clock.elapsed().as_secs_f64();
-    Ok(du)
-}
-
-/// Stage *commit* (what the step hands back): the converged iterate `u` with its end
-/// velocity, work, forces and contact solution.
-#[allow(clippy::too_many_arguments)]
-fn finish(
-    step: &ThetaStep,
-    u: Vec<f64>,
-    asm: Assembled,
-    check: Check,
-    coupling: Box<dyn ContactCoupling<'_> + '_>,
-    contact_residual: f64,
-    v1: &[f64],
-    timings: PhaseTimes,
-) -> Attempt {
-    Attempt {
-        work: step.work(&u, &check.reactions, coupling.contact_force()),
-        v: step.end_velocity(&u, v1),
-        f_ext1: step.f_ext1.clone(),
-        u,
-        f_int1: asm.force,
-        iterations: check.iter - 1,
-        residual: check.relative,
-        internal: asm.energy,
-        solutions: coupling.solutions(),
-        sweeps: coupling.sweeps(),
-        contact_residual,
-        delassus_builds: coupling.delassus_builds(),
-        timings,
-        reactions: check.reactions,
-        points: coupling.into_points(),
-    }
-}
-
-/// Stage *assemble*: internal force, strain energy and tangent at `u`; an inverted element
-/// fails the attempt.
-fn assemble(
-    disc: &Discretisation,
-    u: &[f64],
-    iter: usize,
-    timings: &mut PhaseTimes,
-) -> Result<Assembled, String> {
-    let clock = Instant::now();
-    let asm = disc.assemble(u, true);
-    timings.assembly += clock.elapsed().as_secs_f64();
-    if !(asm.min_j > 0.0) || !asm.energy.is_finite() {
-        return Err(format!(
-            "an element inverted (min det F = {:.3e}) at Newton iteration {iter}",
-            asm.min_j
-        ));
-    }
-    Ok(asm)
-}
-
-/// The out-of-balance force G − Hᵀr of an iterate, measured.
-struct Check {
-    /// Newton iteration (1-based).
-    iter: usize,
-    /// ‖G − Hᵀr‖ on the free unknowns [N].
-    norm: f64,
-    /// The force scale it is measured against [N].
-    scale: f64,
-    /// norm / scale.
-    relative: f64,
-    /// Support reactions [N] (zero on free unknowns).
-    reactions: Vec<f64>,
-}
-
-impl Check {
-    /// Converged when the residual is small against the forces, or when the last correction
-    /// was `negligible` against the step's displacement increment (the residual can sit at
-    /// its round-off floor when every force is small, e.g. a vibrating body passing through
-    /// its rest position).
-    fn converged(&self, tol: f64, negligible: bool) -> bool {
-        self.relative <= tol || self.norm == 0.0 || negligible
-    }
-}
-
-/// Stage *check*: G − Hᵀr against the iterate's force scale (internal, external, inertial,
-/// contact forces and support reactions, so that a large out-of-balance force of an early
-/// iterate does not make later residuals look small). Zeroes `g` on the prescribed unknowns.
-fn check_balance(
-    g: &mut [f64],
-    contact_force: &[f64],
-    constraints: &Constraints,
-    scale: f64,
-    iter: usize,
-) -> Result<Check, String> {
-    let mut out_of_balance: Vec<f64> = g.iter().zip(contact_force).map(|(a, b)| a - b).collect();
-    let reactions = constraints.reactions(&out_of_balance);
-    constraints.zero_fixed(g);
-    constraints.zero_fixed(&mut out_of_balance);
-    let scale = scale.max(norm(contact_force));
-    let residual = norm(&out_of_balance);
-    if !residual.is_finite() {
-        return Err(format!(
-            "the residual is not finite at Newton iteration {iter}"
-        ));
-    }
-    let scale = scale.max(norm(&reactions)).max(f64::MIN_POSITIVE);
-    Ok(Check {
-        iter,
-        norm: residual,
-        scale,
-        relative: residual / scale,
-        reactions,
-    })
 }

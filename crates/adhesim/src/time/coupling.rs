@@ -182,5 +182,5 @@ pub trait ContactCoupling<'a> {
     /// The step failed: drop whatever must not be reused.
     fn abandon(&mut self) {}
     /// The candidates, handed back at the end of the step.
-    fn into_points(self: Box<Self>) -> Vec<ContactPoint>;
+    fn take_points(&mut self) -> Vec<ContactPoint>;
 }

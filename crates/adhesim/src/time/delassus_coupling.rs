@@ -221,8 +221,8 @@ impl<'a> ContactCoupling<'a> for DelassusCoupling<'a> {
         *self.cache = None;
     }
 
-    fn into_points(self: Box<Self>) -> Vec<ContactPoint> {
-        self.sc.points
+    fn take_points(&mut self) -> Vec<ContactPoint> {
+        std::mem::take(&mut self.sc.points)
     }
 }
 

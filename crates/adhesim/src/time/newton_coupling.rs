@@ -213,7 +213,7 @@ impl<'a> ContactCoupling<'a> for NewtonCoupling<'a> {
         self.updates
     }
 
-    fn into_points(self: Box<Self>) -> Vec<ContactPoint> {
-        self.sc.points
+    fn take_points(&mut self) -> Vec<ContactPoint> {
+        std::mem::take(&mut self.sc.points)
     }
 }
