@@ -68,6 +68,17 @@ mod tests {
         LinearElastic::from_young_poisson(7.0e10, 0.33)
     }
 
+    material_checks! {
+        material: material(),
+        small_strain: |m| (m.mu, m.lambda),
+        seed: 41,
+    }
+
+    #[test]
+    fn energy_of_a_zero_deformation_is_finite() {
+        assert!(material().energy(&Mat3::zeros()).is_finite());
+    }
+
     #[test]
     fn is_small_strain_and_from_young_poisson_uses_lame_parameters() {
         let m = LinearElastic::from_young_poisson(2.5, 0.25);
@@ -96,38 +107,5 @@ mod tests {
             2.0 * eps[(0, 2)],
         );
         assert!((d * eps_v - voigt(&sigma)).amax() <= 1e-12 * sigma.amax());
-    }
-
-    #[test]
-    fn stress_matches_fd_of_energy() {
-        check_stress_fd(&material(), 41);
-    }
-
-    #[test]
-    fn tangent_matches_fd_of_stress() {
-        check_tangent_fd(&material(), 42);
-    }
-
-    #[test]
-    fn reference_state_is_stress_free() {
-        check_reference_state(&material());
-    }
-
-    #[test]
-    fn small_strain_limit_is_isotropic_elasticity() {
-        let m = material();
-        check_small_strain_limit(&m, m.mu, m.lambda);
-    }
-
-    #[test]
-    fn isotropic() {
-        check_objectivity(&material(), 43);
-    }
-
-    #[test]
-    fn degenerate_inputs_do_not_panic() {
-        let m = material();
-        check_degenerate_inputs(&m);
-        assert!(m.energy(&Mat3::zeros()).is_finite());
     }
 }

@@ -71,51 +71,11 @@ mod tests {
         }
     }
 
-    #[test]
-    fn stress_matches_fd_of_energy() {
-        check_stress_fd(&material(), 41);
-        // A moderately compressible one, where the isochoric part is not drowned by κ.
-        check_stress_fd(
-            &MooneyRivlin {
-                kappa: 1.0e6,
-                ..material()
-            },
-            42,
-        );
-    }
-
-    #[test]
-    fn tangent_matches_fd_of_stress() {
-        check_tangent_fd(&material(), 43);
-        check_tangent_fd(
-            &MooneyRivlin {
-                kappa: 1.0e6,
-                ..material()
-            },
-            44,
-        );
-    }
-
-    #[test]
-    fn reference_state_is_stress_free() {
-        check_reference_state(&material());
-    }
-
-    #[test]
-    fn small_strain_limit_is_isotropic_elasticity() {
-        let m = material();
-        let mu = 2.0 * (m.c10 + m.c01);
-        check_small_strain_limit(&m, mu, m.kappa - 2.0 * mu / 3.0);
-    }
-
-    #[test]
-    fn isotropic() {
-        check_objectivity(&material(), 45);
-    }
-
-    #[test]
-    fn degenerate_inputs_do_not_panic() {
-        check_degenerate_inputs(&material());
+    material_checks! {
+        material: material(),
+        compressible: MooneyRivlin { kappa: 1.0e6, ..material() },
+        small_strain: |m| (2.0 * (m.c10 + m.c01), m.kappa - 4.0 * (m.c10 + m.c01) / 3.0),
+        seed: 41,
     }
 
     #[test]

@@ -72,43 +72,22 @@ mod tests {
         NeoHookean::from_young_poisson(3.0e6, 0.45)
     }
 
+    material_checks! {
+        material: material(),
+        small_strain: |m| (m.mu, m.lambda),
+        seed: 21,
+    }
+
+    #[test]
+    fn energy_is_infinite_where_j_is_not_positive() {
+        let m = material();
+        assert_eq!(m.energy(&Mat3::zeros()), f64::INFINITY);
+        assert_eq!(m.energy(&-Mat3::identity()), f64::INFINITY);
+    }
+
     #[test]
     fn from_young_poisson_uses_lame_parameters() {
         let m = NeoHookean::from_young_poisson(2.5, 0.25);
         assert!((m.mu - 1.0).abs() < 1e-15 && (m.lambda - 1.0).abs() < 1e-15);
-    }
-
-    #[test]
-    fn stress_matches_fd_of_energy() {
-        check_stress_fd(&material(), 21);
-    }
-
-    #[test]
-    fn tangent_matches_fd_of_stress() {
-        check_tangent_fd(&material(), 22);
-    }
-
-    #[test]
-    fn reference_state_is_stress_free() {
-        check_reference_state(&material());
-    }
-
-    #[test]
-    fn small_strain_limit_is_isotropic_elasticity() {
-        let m = material();
-        check_small_strain_limit(&m, m.mu, m.lambda);
-    }
-
-    #[test]
-    fn isotropic() {
-        check_objectivity(&material(), 23);
-    }
-
-    #[test]
-    fn degenerate_inputs_do_not_panic() {
-        let m = material();
-        check_degenerate_inputs(&m);
-        assert_eq!(m.energy(&Mat3::zeros()), f64::INFINITY);
-        assert_eq!(m.energy(&-Mat3::identity()), f64::INFINITY);
     }
 }

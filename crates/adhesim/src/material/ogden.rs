@@ -140,28 +140,11 @@ mod tests {
         }
     }
 
-    #[test]
-    fn stress_matches_fd_of_energy() {
-        check_stress_fd(&material(), 51);
-        check_stress_fd(
-            &Ogden {
-                kappa: 1.0e6,
-                ..material()
-            },
-            52,
-        );
-    }
-
-    #[test]
-    fn tangent_matches_fd_of_stress() {
-        check_tangent_fd(&material(), 53);
-        check_tangent_fd(
-            &Ogden {
-                kappa: 1.0e6,
-                ..material()
-            },
-            54,
-        );
+    material_checks! {
+        material: material(),
+        compressible: Ogden { kappa: 1.0e6, ..material() },
+        small_strain: |m| (m.mu.iter().sum::<f64>(), m.kappa - 2.0 * m.mu.iter().sum::<f64>() / 3.0),
+        seed: 51,
     }
 
     #[test]
@@ -185,28 +168,6 @@ mod tests {
                 assert!(err < 1e-6, "column {a}: {err:e}");
             }
         }
-    }
-
-    #[test]
-    fn reference_state_is_stress_free() {
-        check_reference_state(&material());
-    }
-
-    #[test]
-    fn small_strain_limit_is_isotropic_elasticity() {
-        let m = material();
-        let mu: f64 = m.mu.iter().sum();
-        check_small_strain_limit(&m, mu, m.kappa - 2.0 * mu / 3.0);
-    }
-
-    #[test]
-    fn isotropic() {
-        check_objectivity(&material(), 55);
-    }
-
-    #[test]
-    fn degenerate_inputs_do_not_panic() {
-        check_degenerate_inputs(&material());
     }
 
     #[test]

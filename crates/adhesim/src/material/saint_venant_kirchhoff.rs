@@ -82,43 +82,21 @@ mod tests {
         SaintVenantKirchhoff::from_young_poisson(2.0e11, 0.3)
     }
 
+    material_checks! {
+        material: material(),
+        small_strain: |m| (m.mu, m.lambda),
+        seed: 31,
+    }
+
+    #[test]
+    fn energy_of_a_zero_deformation_is_finite() {
+        assert!(material().energy(&Mat3::zeros()).is_finite());
+    }
+
     #[test]
     fn from_young_poisson_uses_lame_parameters() {
         let m = SaintVenantKirchhoff::from_young_poisson(2.5, 0.25);
         assert!((m.mu - 1.0).abs() < 1e-15 && (m.lambda - 1.0).abs() < 1e-15);
         assert!(!m.small_strain());
-    }
-
-    #[test]
-    fn stress_matches_fd_of_energy() {
-        check_stress_fd(&material(), 31);
-    }
-
-    #[test]
-    fn tangent_matches_fd_of_stress() {
-        check_tangent_fd(&material(), 32);
-    }
-
-    #[test]
-    fn reference_state_is_stress_free() {
-        check_reference_state(&material());
-    }
-
-    #[test]
-    fn small_strain_limit_is_isotropic_elasticity() {
-        let m = material();
-        check_small_strain_limit(&m, m.mu, m.lambda);
-    }
-
-    #[test]
-    fn isotropic() {
-        check_objectivity(&material(), 33);
-    }
-
-    #[test]
-    fn degenerate_inputs_do_not_panic() {
-        let m = material();
-        check_degenerate_inputs(&m);
-        assert!(m.energy(&Mat3::zeros()).is_finite());
     }
 }

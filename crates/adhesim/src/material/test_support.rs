@@ -207,3 +207,53 @@ pub fn check_degenerate_inputs(m: &dyn Hyperelastic) {
         let _ = m.pk2_and_tangent(&c);
     }
 }
+
+/// The checks every hyperelastic material passes, written as tests into the calling module
+/// (which imports this module's functions): stress against finite differences of the energy
+/// and tangent against finite differences of the stress (for `material` and, where given, a
+/// `compressible` variant whose isochoric part is not drowned by the bulk modulus), a
+/// stress-free reference state, the small-strain limit with shear modulus μ and Lamé λ
+/// computed from the material bound to the given name, objectivity, and degenerate inputs
+/// that do not panic. `seed` (and the next four) pick the random deformations.
+macro_rules! material_checks {
+    (
+        material: $material:expr,
+        $(compressible: $variant:expr,)?
+        small_strain: |$m:ident| ($mu:expr, $lambda:expr),
+        seed: $seed:expr $(,)?
+    ) => {
+        #[test]
+        fn stress_matches_fd_of_energy() {
+            check_stress_fd(&$material, $seed);
+            $(check_stress_fd(&$variant, $seed + 1);)?
+        }
+
+        #[test]
+        fn tangent_matches_fd_of_stress() {
+            check_tangent_fd(&$material, $seed + 2);
+            $(check_tangent_fd(&$variant, $seed + 3);)?
+        }
+
+        #[test]
+        fn reference_state_is_stress_free() {
+            check_reference_state(&$material);
+        }
+
+        #[test]
+        fn small_strain_limit_is_isotropic_elasticity() {
+            let $m = $material;
+            check_small_strain_limit(&$m, $mu, $lambda);
+        }
+
+        #[test]
+        fn isotropic() {
+            check_objectivity(&$material, $seed + 4);
+        }
+
+        #[test]
+        fn degenerate_inputs_do_not_panic() {
+            check_degenerate_inputs(&$material);
+        }
+    };
+}
+pub(crate) use material_checks;

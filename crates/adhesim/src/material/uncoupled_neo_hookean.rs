@@ -57,45 +57,18 @@ mod tests {
         UncoupledNeoHookean::from_young_poisson(1.0e6, 0.4999)
     }
 
+    material_checks! {
+        material: material(),
+        compressible: UncoupledNeoHookean::from_young_poisson(1.0e6, 0.3),
+        small_strain: |m| (2.0 * m.c10, m.kappa - 4.0 * m.c10 / 3.0),
+        seed: 31,
+    }
+
     #[test]
     fn young_poisson_conversion() {
         let m = UncoupledNeoHookean::from_young_poisson(2.6, 0.3);
         assert!((2.0 * m.c10 - 1.0).abs() < 1e-15);
         assert!((m.kappa - 2.6 / 1.2).abs() < 1e-15);
-    }
-
-    #[test]
-    fn stress_matches_fd_of_energy() {
-        check_stress_fd(&material(), 31);
-        check_stress_fd(&UncoupledNeoHookean::from_young_poisson(1.0e6, 0.3), 32);
-    }
-
-    #[test]
-    fn tangent_matches_fd_of_stress() {
-        check_tangent_fd(&material(), 33);
-        check_tangent_fd(&UncoupledNeoHookean::from_young_poisson(1.0e6, 0.3), 34);
-    }
-
-    #[test]
-    fn reference_state_is_stress_free() {
-        check_reference_state(&material());
-    }
-
-    #[test]
-    fn small_strain_limit_is_isotropic_elasticity() {
-        let m = material();
-        let mu = 2.0 * m.c10;
-        check_small_strain_limit(&m, mu, m.kappa - 2.0 * mu / 3.0);
-    }
-
-    #[test]
-    fn isotropic() {
-        check_objectivity(&material(), 35);
-    }
-
-    #[test]
-    fn degenerate_inputs_do_not_panic() {
-        check_degenerate_inputs(&material());
     }
 
     #[test]
