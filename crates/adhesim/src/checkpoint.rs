@@ -189,29 +189,8 @@ impl Checkpoint {
         for nodes in contact {
             w.usize(nodes.len());
             for c in nodes {
-                let NodeContact {
-                    beta,
-                    ut,
-                    r_dry,
-                    r_adh,
-                    force,
-                    gap,
-                    slip,
-                    state,
-                    tangent_axes,
-                    damage,
-                } = c;
-                w.f64(*beta);
-                ut.iter()
-                    .chain(r_dry)
-                    .chain(r_adh)
-                    .chain(force)
-                    .chain([gap])
-                    .chain(slip)
-                    .chain(tangent_axes.iter().flatten())
-                    .chain([damage])
-                    .for_each(|x| w.f64(*x));
-                w.0.extend_from_slice(&state.to_le_bytes());
+                c.to_values().iter().for_each(|x| w.f64(*x));
+                w.0.extend_from_slice(&c.state.to_le_bytes());
             }
         }
         w.f64s(material_history);
@@ -273,29 +252,15 @@ impl Checkpoint {
         let pairs = r.len(8)?;
         let mut contact = Vec::with_capacity(pairs);
         for _ in 0..pairs {
-            let n = r.len(8 * 23 + 4)?;
+            let n = r.len(8 * NodeContact::VALUES + 4)?;
             let mut nodes = Vec::with_capacity(n);
             for _ in 0..n {
-                // β, then 3 + 3 + 3 + 3 + 1 + 2 + 6 + 1 values, then the state.
-                let mut x = [0.0; 22];
-                let beta = r.f64()?;
+                let mut x = [0.0; NodeContact::VALUES];
                 for xi in &mut x {
                     *xi = r.f64()?;
                 }
                 let state = i32::from_le_bytes(r.take(4)?.try_into().unwrap());
-                let a3 = |k: usize| [x[k], x[k + 1], x[k + 2]];
-                nodes.push(NodeContact {
-                    beta,
-                    ut: a3(0),
-                    r_dry: a3(3),
-                    r_adh: a3(6),
-                    force: a3(9),
-                    gap: x[12],
-                    slip: [x[13], x[14]],
-                    state,
-                    tangent_axes: [a3(15), a3(18)],
-                    damage: x[21],
-                });
+                nodes.push(NodeContact::from_values(&x, state));
             }
             contact.push(nodes);
         }

@@ -142,6 +142,52 @@ pub struct NodeContact {
     pub damage: f64,
 }
 
+impl NodeContact {
+    /// How many numbers [`NodeContact::to_values`] gives (the state code aside).
+    pub const VALUES: usize = 23;
+
+    /// Every real-valued field, in a fixed order: β, u_t (3), r̄ (3), r̃ (3), force (3), gap,
+    /// slip (2), tangent axes (2 × 3), dissipated energy. With [`NodeContact::state`] this is
+    /// the whole node (the checkpoint format).
+    pub fn to_values(&self) -> [f64; Self::VALUES] {
+        let mut v = [0.0; Self::VALUES];
+        let parts: [&[f64]; 9] = [
+            &[self.beta],
+            &self.ut,
+            &self.r_dry,
+            &self.r_adh,
+            &self.force,
+            &[self.gap],
+            &self.slip,
+            self.tangent_axes.as_flattened(),
+            &[self.damage],
+        ];
+        let mut k = 0;
+        for x in parts.into_iter().flatten() {
+            v[k] = *x;
+            k += 1;
+        }
+        v
+    }
+
+    /// The node whose [`NodeContact::to_values`] are `v`, with state code `state`.
+    pub fn from_values(v: &[f64; Self::VALUES], state: i32) -> Self {
+        let a3 = |k: usize| [v[k], v[k + 1], v[k + 2]];
+        NodeContact {
+            beta: v[0],
+            ut: a3(1),
+            r_dry: a3(4),
+            r_adh: a3(7),
+            force: a3(10),
+            gap: v[13],
+            slip: [v[14], v[15]],
+            state,
+            tangent_axes: [a3(16), a3(19)],
+            damage: v[22],
+        }
+    }
+}
+
 /// The state of the bodies.
 #[derive(Clone, Debug)]
 pub struct State {
