@@ -19,7 +19,7 @@ use adhesim::assembly::Discretisation;
 use adhesim::fbar::Formulation;
 use adhesim::material::{Hyperelastic, MooneyRivlin, UncoupledNeoHookean};
 use adhesim::mesh::{generate, Mesh};
-use adhesim::problem::{Dirichlet, NodalLoad, Problem, Table};
+use adhesim::problem::{Dirichlet, NodalLoad, Table};
 use adhesim::time::Stepper;
 use std::sync::Arc;
 
@@ -28,21 +28,6 @@ use common::*;
 
 const NU: f64 = 0.4999;
 const ANP: Formulation = Formulation::AveragedNodalPressure;
-
-fn ramp(v: f64) -> Table {
-    Table {
-        t: vec![0.0, 1.0],
-        v: vec![0.0, v],
-    }
-}
-
-fn solve(p: Problem) -> Stepper {
-    let mut s = Stepper::new(Arc::new(p)).unwrap();
-    while !s.finished() {
-        s.step().expect("quasi-static load step converges");
-    }
-    s
-}
 
 /// A unit cube of n³ hexahedra split into tetrahedra, interior nodes moved at random by up
 /// to `shake` of an element size.
@@ -140,28 +125,7 @@ fn force_and_tangent_are_the_derivatives_of_the_energy() {
 #[test]
 fn patch_reproduces_a_large_homogeneous_deformation() {
     let (mesh, boundary) = shaken_tet_cube(3, 0.1, 4242);
-    let a = [[0.3, 0.2, 0.0], [0.0, -0.1, 0.05], [0.1, 0.0, 0.1]];
-    let field =
-        |x: [f64; 3]| -> [f64; 3] { std::array::from_fn(|i| (0..3).map(|j| a[i][j] * x[j]).sum()) };
-    let material: Arc<dyn Hyperelastic> =
-        Arc::new(UncoupledNeoHookean::from_young_poisson(1.0e6, 0.45));
-    let mut p = one_body(mesh.clone(), material, 1000.0, quasi_static(1.0, 1.0));
-    p.bodies[0].element = ANP;
-    for &n in &boundary {
-        p.dirichlet.push(Dirichlet {
-            nodes: vec![n],
-            components: [true; 3],
-            translation: field(mesh.nodes[n]).map(ramp),
-            rotation: None,
-        });
-    }
-    let s = solve(p);
-    let mut err: f64 = 0.0;
-    for (i, &x) in mesh.nodes.iter().enumerate() {
-        for (k, uk) in field(x).iter().enumerate() {
-            err = err.max((s.state.u[3 * i + k] - uk).abs());
-        }
-    }
+    let err = homogeneous_patch_error(&mesh, &boundary, ANP);
     // Newton stops at a relative residual of 1e-12; displacements are ~0.3 m.
     assert!(err < 1e-10, "max nodal error {err:e} m");
 }

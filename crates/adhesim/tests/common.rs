@@ -1,9 +1,11 @@
 //! Helpers shared by the verification tests.
 #![allow(dead_code)]
 
-use adhesim::material::Hyperelastic;
+use adhesim::fbar::Formulation;
+use adhesim::material::{Hyperelastic, UncoupledNeoHookean};
 use adhesim::mesh::Mesh;
 use adhesim::problem::{Body, Dirichlet, OutputSettings, Problem, Table, TimeSettings};
+use adhesim::time::Stepper;
 use std::sync::Arc;
 
 /// Deterministic pseudo-random numbers in [−1, 1) (xorshift), so tests are repeatable.
@@ -73,4 +75,51 @@ pub fn quasi_static(t_end: f64, dt: f64) -> TimeSettings {
         newton_tol: 1e-12,
         ..TimeSettings::default()
     }
+}
+
+/// The table 0 at t = 0 rising linearly to `v` at t = 1.
+pub fn ramp(v: f64) -> Table {
+    Table {
+        t: vec![0.0, 1.0],
+        v: vec![0.0, v],
+    }
+}
+
+/// Runs a quasi-static problem to its end; returns the stepper.
+pub fn solve(p: Problem) -> Stepper {
+    let mut s = Stepper::new(Arc::new(p)).unwrap();
+    while !s.finished() {
+        s.step().expect("quasi-static load step converges");
+    }
+    s
+}
+
+/// Patch test: prescribes u = A x on the `boundary` nodes of `mesh` (A with stretches and
+/// shears of 10-30 % and J ≠ 1) for a nearly incompressible neo-Hookean body of elements
+/// `element`, and returns the largest nodal error against A x [m] (the element must
+/// reproduce the homogeneous deformation exactly, to the Newton tolerance).
+pub fn homogeneous_patch_error(mesh: &Mesh, boundary: &[usize], element: Formulation) -> f64 {
+    let a = [[0.3, 0.2, 0.0], [0.0, -0.1, 0.05], [0.1, 0.0, 0.1]];
+    let field =
+        |x: [f64; 3]| -> [f64; 3] { std::array::from_fn(|i| (0..3).map(|j| a[i][j] * x[j]).sum()) };
+    let material: Arc<dyn Hyperelastic> =
+        Arc::new(UncoupledNeoHookean::from_young_poisson(1.0e6, 0.45));
+    let mut p = one_body(mesh.clone(), material, 1000.0, quasi_static(1.0, 1.0));
+    p.bodies[0].element = element;
+    for &n in boundary {
+        p.dirichlet.push(Dirichlet {
+            nodes: vec![n],
+            components: [true; 3],
+            translation: field(mesh.nodes[n]).map(ramp),
+            rotation: None,
+        });
+    }
+    let s = solve(p);
+    let mut err: f64 = 0.0;
+    for (i, &x) in mesh.nodes.iter().enumerate() {
+        for (k, uk) in field(x).iter().enumerate() {
+            err = err.max((s.state.u[3 * i + k] - uk).abs());
+        }
+    }
+    err
 }
