@@ -195,32 +195,7 @@ fn cantilever(ny: usize, element: Formulation) -> f64 {
 }
 
 fn cantilever_nu(ny: usize, element: Formulation, nu: f64) -> f64 {
-    let (l, h, e) = (1.0, 0.1, 1.0e6);
-    let mesh = generate::block([l, h, h / ny as f64], [10 * ny, ny, 1]).split_hexes_into_tets();
-    let material = UncoupledNeoHookean::from_young_poisson(e, nu);
-    let mut p = one_body(
-        mesh.clone(),
-        Arc::new(material),
-        1000.0,
-        quasi_static(1.0, 1.0),
-    );
-    p.bodies[0].element = element;
-    p.time.newton_tol = 1e-10;
-    p.dirichlet
-        .push(fixed((0..mesh.num_nodes()).collect(), [false, false, true]));
-    p.dirichlet
-        .push(fixed(mesh.node_sets["left"].clone(), [true, true, false]));
-    let right = mesh.node_sets["right"].clone();
-    let depth = h / ny as f64;
-    let inertia = depth * h.powi(3) / 12.0;
-    let p_tip = 1e-3 * l * 3.0 * e / (1.0 - NU * NU) * inertia / l.powi(3);
-    p.loads.push(NodalLoad {
-        nodes: right.clone(),
-        total_force: [Table::constant(0.0), ramp(-p_tip), Table::constant(0.0)],
-    });
-    let s = solve(p);
-    let tip = right.iter().map(|&n| s.state.u[3 * n + 1]).sum::<f64>() / right.len() as f64;
-    -tip / (1e-3 * l)
+    plane_strain_cantilever(ny, true, element, nu, NU)
 }
 
 #[test]

@@ -3,8 +3,8 @@
 
 use adhesim::fbar::Formulation;
 use adhesim::material::{Hyperelastic, UncoupledNeoHookean};
-use adhesim::mesh::Mesh;
-use adhesim::problem::{Body, Dirichlet, OutputSettings, Problem, Table, TimeSettings};
+use adhesim::mesh::{generate, Mesh};
+use adhesim::problem::{Body, Dirichlet, NodalLoad, OutputSettings, Problem, Table, TimeSettings};
 use adhesim::time::Stepper;
 use std::sync::Arc;
 
@@ -122,4 +122,48 @@ pub fn homogeneous_patch_error(mesh: &Mesh, boundary: &[usize], element: Formula
         }
     }
     err
+}
+
+/// A plane-strain cantilever (L = 1 m, h = 0.1 m, slab one element thick, `ny` elements
+/// through the height and 10 `ny` along, hexahedra or each split into tetrahedra) of a
+/// neo-Hookean material with E = 1 MPa and Poisson ratio `nu`, clamped at x = 0, under a
+/// tip load that gives δ = 1e-3 L by Euler-Bernoulli for E′ = E/(1 − `nu_load`²). Returns the
+/// mean tip deflection in units of 1e-3 L (1 is Euler-Bernoulli's answer when
+/// `nu_load` = `nu`).
+pub fn plane_strain_cantilever(
+    ny: usize,
+    tets: bool,
+    element: Formulation,
+    nu: f64,
+    nu_load: f64,
+) -> f64 {
+    let (l, h, e) = (1.0, 0.1, 1.0e6);
+    let mut mesh = generate::block([l, h, h / ny as f64], [10 * ny, ny, 1]);
+    if tets {
+        mesh = mesh.split_hexes_into_tets();
+    }
+    let material = UncoupledNeoHookean::from_young_poisson(e, nu);
+    let mut p = one_body(
+        mesh.clone(),
+        Arc::new(material),
+        1000.0,
+        quasi_static(1.0, 1.0),
+    );
+    p.bodies[0].element = element;
+    p.time.newton_tol = 1e-10;
+    p.dirichlet
+        .push(fixed((0..mesh.num_nodes()).collect(), [false, false, true]));
+    p.dirichlet
+        .push(fixed(mesh.node_sets["left"].clone(), [true, true, false]));
+    let right = mesh.node_sets["right"].clone();
+    let depth = h / ny as f64;
+    let inertia = depth * h.powi(3) / 12.0;
+    let p_tip = 1e-3 * l * 3.0 * e / (1.0 - nu_load * nu_load) * inertia / l.powi(3);
+    p.loads.push(NodalLoad {
+        nodes: right.clone(),
+        total_force: [Table::constant(0.0), ramp(-p_tip), Table::constant(0.0)],
+    });
+    let s = solve(p);
+    let tip = right.iter().map(|&n| s.state.u[3 * n + 1]).sum::<f64>() / right.len() as f64;
+    -tip / (1e-3 * l)
 }
