@@ -17,8 +17,7 @@ mod newton_loop;
 pub use constraints::Constraints;
 
 use crate::assembly::{BadElement, Discretisation};
-use crate::contact::anisotropic::align_frames;
-use crate::contact::detect::{detect, ContactPoint};
+use crate::contact::detect::{align_frames, detect, ContactPoint};
 use crate::contact::law::{accumulated_damage, BondState, ContactState, PointSolution};
 use crate::linalg::LinalgError;
 use crate::problem::{ContactSolver, Problem};

@@ -7,6 +7,12 @@
 //! the resultant is F_t = −N (μ₁² cos θ, μ₂² sin θ)/√(μ₁² cos² θ + μ₂² sin² θ), with N the
 //! total normal force, whatever the pressure distribution.
 
+use adhesim::contact::anisotropic::{sliding_friction, Orthotropy};
+use adhesim::contact::law::{
+    adhesive_response, natural_map_defect, solve_point, BondState, InterfaceLaw, PointProblem,
+    RccParams,
+};
+use adhesim::contact::newton::augmented_point;
 use adhesim::time::Stepper;
 use std::path::Path;
 use std::sync::Arc;
@@ -81,4 +87,163 @@ fn equal_coefficients_on_material_axes_reproduce_the_isotropic_law() {
     // And the isotropic friction force is along the slip: |F_t| = μ N.
     let ft = iso.1.hypot(iso.2);
     assert!((ft / iso.0 - MU1).abs() < 1e-6, "{}", ft / iso.0);
+}
+
+// The law at one point: the Gauss-Seidel point solve and the Newton solve's law.
+
+fn law(mu1: f64, mu2: f64) -> InterfaceLaw {
+    InterfaceLaw {
+        mu: mu1,
+        adhesion: None,
+        anisotropy: Some(Orthotropy {
+            axis: [1.0, 0.0, 0.0],
+            mu2,
+        }),
+    }
+}
+
+/// A point pushed along the plane with a stiff compliance slides; its friction force is
+/// on the ellipse, opposite to the slip's dual direction, as the closed form says, for
+/// slips along each axis and at 45°.
+#[test]
+fn sliding_point_lands_on_the_ellipse_with_the_maximal_dissipation_direction() {
+    let (mu1, mu2) = (0.6, 0.2);
+    let l = law(mu1, mu2);
+    let c = 1e-6; // compliance [m/N]
+    for angle in [0.0f64, 45.0, 90.0, 30.0] {
+        let a = angle.to_radians();
+        // Free displacement: pressed 1 mm into the plane and pushed 10 mm along (cos, sin).
+        let x_free = [1e-2 * a.cos(), 1e-2 * a.sin(), -1e-3];
+        let p = PointProblem {
+            w_aa: [[c, 0.0, 0.0], [0.0, c, 0.0], [0.0, 0.0, c]],
+            x_free,
+            law: &l,
+            bond0: BondState::default(),
+            dt: 1e-3,
+            area: 1e-6,
+            rho: 1.0 / c,
+        };
+        let sol = solve_point(&p, [0.0; 3], 1e-12, 100);
+        assert!(sol.converged, "{angle}°");
+        let rn = sol.r_dry[2];
+        assert!((rn - 1e-3 / c).abs() < 1e-9 * rn, "{angle}°: r_n {rn}");
+        // On the ellipse.
+        let e = (sol.r_dry[0] / mu1).hypot(sol.r_dry[1] / mu2) / rn;
+        assert!((e - 1.0).abs() < 1e-10, "{angle}°: {e}");
+        // The slip direction and the force by maximal dissipation.
+        let slip_len = sol.x[0].hypot(sol.x[1]);
+        let d = [sol.x[0] / slip_len, sol.x[1] / slip_len];
+        let expect = sliding_friction(mu1, mu2, rn, d);
+        for k in 0..2 {
+            assert!(
+                (sol.r_dry[k] - expect[k]).abs() < 1e-9 * rn,
+                "{angle}°: r_t {:?} vs {expect:?}",
+                sol.r_dry
+            );
+        }
+        // The Newton solve's law agrees at the same x with λ = r̄ (a fixed point).
+        let ap = augmented_point(
+            &l,
+            BondState::default(),
+            1e-3,
+            1e-6,
+            1.0 / c,
+            sol.r_dry,
+            sol.x,
+        );
+        for k in 0..3 {
+            assert!(
+                (ap.solution.r_dry[k] - sol.r_dry[k]).abs() < 1e-9 * rn,
+                "{angle}°"
+            );
+        }
+        let defect = natural_map_defect(&l, 1.0 / c, sol.r_dry, sol.x);
+        assert!(
+            defect.iter().all(|v| v.abs() < 1e-9 * rn),
+            "{angle}°: {defect:?}"
+        );
+    }
+}
+
+/// μ₁ = μ₂ and C_t1 = C_t2 on aligned axes give the isotropic law's solution.
+#[test]
+fn equal_coefficients_reproduce_the_isotropic_law() {
+    let mut rcc = RccParams::new(20.0, 2e9, 2e9, 0.1);
+    rcc.ct2 = rcc.ct;
+    let iso = InterfaceLaw {
+        mu: 0.4,
+        adhesion: Some(rcc),
+        anisotropy: None,
+    };
+    let ortho = InterfaceLaw {
+        anisotropy: Some(Orthotropy {
+            axis: [1.0, 0.0, 0.0],
+            mu2: 0.4,
+        }),
+        ..iso
+    };
+    let w = [[2e-6, 3e-7, 1e-7], [3e-7, 1e-6, -2e-7], [1e-7, -2e-7, 3e-6]];
+    for x_free in [
+        [1e-4, -3e-5, -2e-5],
+        [2e-6, 1e-6, 5e-6],
+        [1e-3, 1e-3, -1e-6],
+    ] {
+        let bond0 = BondState {
+            beta: 0.7,
+            ut: [1e-6, -2e-6],
+            damage: 0.0,
+        };
+        let p = |law| PointProblem {
+            w_aa: w,
+            x_free,
+            law,
+            bond0,
+            dt: 1e-3,
+            area: 1e-6,
+            rho: 0.0,
+        };
+        let a = solve_point(&p(&iso), [0.0; 3], 1e-12, 200);
+        let b = solve_point(&p(&ortho), [0.0; 3], 1e-12, 200);
+        assert_eq!(a, b);
+    }
+}
+
+/// Orthotropic tangential adhesion: a bonded point stretched along t₁ or t₂ carries
+/// −C_ti u_i β² A, the law's energy gradient.
+#[test]
+fn orthotropic_adhesion_stiffness_per_axis() {
+    let mut rcc = RccParams::new(20.0, 2e9, 4e9, 0.0);
+    rcc.ct2 = 1e9;
+    let area = 1e-6;
+    let bond = BondState {
+        beta: 1.0,
+        ut: [0.0; 2],
+        damage: 0.0,
+    };
+    let u = 1e-7; // well inside the bond's strength: β stays 1
+    for (k, ct) in [(0usize, 4e9), (1, 1e9)] {
+        let mut x = [0.0; 3];
+        x[k] = u;
+        let r = adhesive_response(&rcc, bond, 1e-3, area, x);
+        assert_eq!(r.beta, 1.0);
+        let expect = -ct * u * area;
+        assert!(
+            (r.force[k] - expect).abs() < 1e-12 * expect.abs(),
+            "axis {k}"
+        );
+        assert_eq!(r.force[1 - k], 0.0);
+        assert!((r.secant_stiffness[k][k] - ct * area).abs() < 1e-6);
+        // −∂φ/∂x_k by central differences.
+        let h = 1e-10;
+        let (mut xp, mut xm) = (x, x);
+        xp[k] += h;
+        xm[k] -= h;
+        let fd = -(adhesive_response(&rcc, bond, 1e-3, area, xp).energy
+            - adhesive_response(&rcc, bond, 1e-3, area, xm).energy)
+            / (2.0 * h);
+        assert!(
+            (fd - r.force[k]).abs() < 1e-6 * r.force[k].abs(),
+            "axis {k}: {fd}"
+        );
+    }
 }

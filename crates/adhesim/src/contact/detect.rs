@@ -3,6 +3,7 @@
 //! sparse operator H (rows T₁ᵀ, T₂ᵀ, Nᵀ applied to the slave node minus the master nodes
 //! weighted by their shape functions at the projection).
 
+use super::anisotropic::aligned_frame;
 use super::law::InterfaceLaw;
 use crate::mesh::Face;
 use crate::problem::{rotate, Rotation, Table};
@@ -468,6 +469,18 @@ impl FaceGrid {
     fn candidates(&self, x: [f64; 3]) -> &[usize] {
         let key = x.map(|v| (v / self.cell).floor() as i64);
         self.map.get(&key).map_or(&[], |v| v.as_slice())
+    }
+}
+
+/// Turns the frames of the points of orthotropic pairs to their material axes
+/// ([`super::anisotropic`]); points where the axis is normal to the surface keep their frame.
+pub fn align_frames(points: &mut [ContactPoint], pairs: &[ContactPair]) {
+    for pt in points {
+        if let Some(o) = &pairs[pt.pair].law.anisotropy {
+            if let Some(frame) = aligned_frame(pt.frame[2], o.axis) {
+                pt.frame = frame;
+            }
+        }
     }
 }
 

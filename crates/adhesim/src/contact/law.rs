@@ -31,7 +31,7 @@
 //!   compression that leaves the cone, so `− μ n` is used, as docs/model.md says.
 
 pub use super::anisotropic::Orthotropy;
-use super::anisotropic::{scale, scale_matrix, tangent_scale, unscale, unscale_matrix};
+use super::anisotropic::{scale, scale_matrix, unscale, unscale_matrix};
 use std::f64::consts::PI;
 
 /// Default bond cut-off ε of the RCC law: below it a bond is broken.
@@ -125,6 +125,36 @@ pub struct InterfaceLaw {
     /// Material axes and μ₂ of an orthotropic interface (elliptic friction cone), or `None`
     /// for an isotropic one ([`super::anisotropic`]).
     pub anisotropy: Option<Orthotropy>,
+}
+
+impl InterfaceLaw {
+    /// The scale s = μ₂/μ₁ of the second tangential axis that maps the law's cone on the
+    /// circular cone of μ₁ ([`super::anisotropic`]): 1 for an isotropic law (and for μ₁ = μ₂).
+    pub fn tangent_scale(&self) -> f64 {
+        match &self.anisotropy {
+            Some(o) if o.mu2 != self.mu && self.mu > 0.0 && o.mu2 > 0.0 => o.mu2 / self.mu,
+            _ => 1.0,
+        }
+    }
+}
+
+/// The defect r̄ − P_K(r̄ − ρ x̂) [N] of the law's bi-potential condition at a dry force `r_dry`
+/// [N] and local relative displacement `x` [m], with `rho` [N/m]: zero exactly at a solution.
+/// For an orthotropic law it is evaluated in the scaled variables and mapped back by T.
+pub fn natural_map_defect(law: &InterfaceLaw, rho: f64, r_dry: [f64; 3], x: [f64; 3]) -> [f64; 3] {
+    let s = law.tangent_scale();
+    let (r, y) = if s == 1.0 {
+        (r_dry, x)
+    } else {
+        (unscale(r_dry, s), scale(x, s))
+    };
+    let p = dry_projection(bipotential_trial(r, y, law.mu, rho), law.mu).0;
+    let d = [r[0] - p[0], r[1] - p[1], r[2] - p[2]];
+    if s == 1.0 {
+        d
+    } else {
+        scale(d, s)
+    }
 }
 
 /// Which case of the bi-potential projection the dry part fell into. Whether the point is
@@ -421,7 +451,7 @@ fn solve_point_impl(
     max_iter: usize,
     method: Method,
 ) -> PointSolution {
-    let s = tangent_scale(p.law);
+    let s = p.law.tangent_scale();
     if s == 1.0 {
         return solve_scaled(p, r_start, tol, max_iter, method, 1.0);
     }

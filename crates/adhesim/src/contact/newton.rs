@@ -18,7 +18,7 @@
 //!
 //! Everything here is pure: the stepper owns the loop.
 
-use super::anisotropic::{scale, scale_matrix, tangent_scale, unscale};
+use super::anisotropic::{scale, scale_matrix, unscale};
 use super::detect::ContactPoint;
 use super::law::{
     adhesive_response, bipotential_trial, dry_projection, BondState, ContactState, InterfaceLaw,
@@ -138,7 +138,7 @@ pub fn augmented_point(
     lambda: [f64; 3],
     x: [f64; 3],
 ) -> AugmentedPoint {
-    let s = tangent_scale(law);
+    let s = law.tangent_scale();
     let dry = if s == 1.0 {
         augmented_dry_force(law.mu, rho, lambda, x)
     } else {

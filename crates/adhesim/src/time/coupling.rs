@@ -6,8 +6,8 @@
 
 use super::constraints::Constraints;
 use super::PhaseTimes;
-use crate::contact::anisotropic::natural_map_defect;
 use crate::contact::detect::ContactPoint;
+use crate::contact::law::natural_map_defect;
 use crate::contact::law::{BondState, PointSolution};
 use crate::contact::newton;
 use crate::contact::InterfaceLaw;
