@@ -155,34 +155,39 @@ fn newton_and_gauss_seidel_agree_on_the_indentation_cycle() {
 
 /// 4.3 coarse, μ = 0.4, descent at 1 m/s (plane strain): the slab's out-of-plane direction
 /// is fixed, so no friction may act along it. The total contact force's z component must
-/// vanish against its y component (to 1e-8) at every step, and so must every node's.
+/// vanish against its y component (to 1e-8) at every step, and so must every node's, on both
+/// contact solvers. (The Gauss-Seidel point solve once put friction there: a stuck point's
+/// compliance has no out-of-plane part, so its stick force was not found and a degenerate
+/// slide with the cone used up out of plane was accepted instead.)
 #[test]
 fn plane_strain_carries_no_out_of_plane_friction() {
-    let trace = run(load(
-        "plate-on-cylinder.toml",
-        Some("coarse"),
-        &[
-            "mu=0.4",
-            "v_descent=1.0",
-            "time.t_end=2e-3",
-            "time.contact_solver=newton",
-        ],
-    ));
-    let mut checked = 0;
-    for (t, pairs) in &trace {
-        let nodes = &pairs[0];
-        let fy: f64 = nodes.iter().map(|n| n.force[1]).sum();
-        let fz: f64 = nodes.iter().map(|n| n.force[2]).sum();
-        let fz_node = nodes.iter().map(|n| n.force[2].abs()).fold(0.0, f64::max);
-        if fy.abs() > 1e-3 {
-            assert!(
-                fz.abs() < 1e-8 * fy.abs() && fz_node < 1e-8 * fy.abs(),
-                "t = {t}: fz = {fz:e} N (largest nodal {fz_node:e} N) against fy = {fy:e} N"
-            );
-            checked += 1;
+    for solver in ["gauss-seidel", "newton"] {
+        let trace = run(load(
+            "plate-on-cylinder.toml",
+            Some("coarse"),
+            &[
+                "mu=0.4",
+                "v_descent=1.0",
+                "time.t_end=2e-3",
+                &format!("time.contact_solver={solver}"),
+            ],
+        ));
+        let mut checked = 0;
+        for (t, pairs) in &trace {
+            let nodes = &pairs[0];
+            let fy: f64 = nodes.iter().map(|n| n.force[1]).sum();
+            let fz: f64 = nodes.iter().map(|n| n.force[2]).sum();
+            let fz_node = nodes.iter().map(|n| n.force[2].abs()).fold(0.0, f64::max);
+            if fy.abs() > 1e-3 {
+                assert!(
+                    fz.abs() < 1e-8 * fy.abs() && fz_node < 1e-8 * fy.abs(),
+                    "{solver}, t = {t}: fz = {fz:e} N (largest nodal {fz_node:e} N) against fy = {fy:e} N"
+                );
+                checked += 1;
+            }
         }
+        assert!(checked > 10, "{solver}: only {checked} steps in contact");
     }
-    assert!(checked > 10, "only {checked} steps in contact");
 }
 
 /// A block dragged over a rigid plane (friction μ = 0.5, pulled above μN): the frictional

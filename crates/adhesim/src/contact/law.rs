@@ -571,7 +571,7 @@ fn solve_by_cases(ctx: &Ctx, r_start: V3, max_iter: usize) -> Result<PointSoluti
         Some(a) => adhesion_eval(ctx, a, [0.0; 3]).force,
         None => [0.0; 3],
     };
-    let r_stick = solve3(p.w_aa, neg(p.x_free)).map(|r| sub(r, r_adh0));
+    let r_stick = stick_force(p.w_aa, p.x_free).map(|r| sub(r, r_adh0));
     if let Some(rs) = r_stick {
         if rs[2] >= 0.0 && norm2(rs[0], rs[1]) <= ctx.mu * rs[2] {
             let ev = evaluate(ctx, rs, r_adh0);
@@ -1230,6 +1230,49 @@ fn sym(a: M3) -> M3 {
         }
     }
     s
+}
+
+/// The total force r with W r = −x_free (the point stuck: x = 0). Where the compliance W has
+/// a local axis along which no force moves the point (a diagonal entry negligible against the
+/// largest, e.g. the out-of-plane tangent of a plane-strain model, whose unknowns are held),
+/// the force has no component along it (the least-norm solution) provided x_free has none
+/// either; the other components solve the remaining rows. None when no such force exists.
+fn stick_force(w: M3, x_free: V3) -> Option<V3> {
+    if let Some(r) = solve3(w, neg(x_free)) {
+        return Some(r);
+    }
+    let big = w.iter().flatten().fold(0.0_f64, |acc, v| acc.max(v.abs()));
+    if !(big.is_finite() && big > 0.0) {
+        return None;
+    }
+    // W is symmetric positive semi-definite: a negligible diagonal entry bounds its whole row
+    // and column (|W_ij| ≤ √(W_ii W_jj)).
+    let null: Vec<bool> = (0..3).map(|i| w[i][i].abs() <= 1e-12 * big).collect();
+    let free: Vec<usize> = (0..3).filter(|&i| !null[i]).collect();
+    if free.len() == 3 || free.is_empty() {
+        return None;
+    }
+    // A direction the force cannot move must already be at rest.
+    let scale = norm(x_free);
+    if (0..3).any(|i| null[i] && x_free[i].abs() > 1e-9 * scale) {
+        return None;
+    }
+    let mut r = [0.0; 3];
+    match free.as_slice() {
+        &[a] => {
+            r[a] = -x_free[a] / w[a][a];
+        }
+        &[a, b] => {
+            let det = w[a][a] * w[b][b] - w[a][b] * w[b][a];
+            if det.is_nan() || det.abs() <= 1e-14 * big * big {
+                return None;
+            }
+            r[a] = (-x_free[a] * w[b][b] + x_free[b] * w[a][b]) / det;
+            r[b] = (-x_free[b] * w[a][a] + x_free[a] * w[b][a]) / det;
+        }
+        _ => return None,
+    }
+    r.iter().all(|v| v.is_finite()).then_some(r)
 }
 
 /// Solves m x = b by Gaussian elimination with partial pivoting; `None` when m is singular to
