@@ -19,7 +19,7 @@ use adhesim::assembly::Discretisation;
 use adhesim::fbar::Formulation;
 use adhesim::material::{Hyperelastic, MooneyRivlin, UncoupledNeoHookean};
 use adhesim::mesh::{generate, Mesh};
-use adhesim::problem::{Dirichlet, NodalLoad, Table};
+use adhesim::problem::{Dirichlet, Table};
 use adhesim::time::Stepper;
 use std::sync::Arc;
 
@@ -156,25 +156,9 @@ fn volume_change(disc: &Discretisation, u: &[f64]) -> (f64, f64) {
 #[test]
 fn block_under_large_shear_keeps_its_volume() {
     let mesh = generate::block([1.0, 1.0, 1.0], [4, 4, 4]).split_hexes_into_tets();
+    let s = sheared_block(&mesh, ANP, NU);
     let material: Arc<dyn Hyperelastic> =
         Arc::new(UncoupledNeoHookean::from_young_poisson(1.0e6, NU));
-    let mut p = one_body(
-        mesh.clone(),
-        material.clone(),
-        1000.0,
-        quasi_static(1.0, 0.25),
-    );
-    p.bodies[0].element = ANP;
-    p.time.newton_tol = 1e-10;
-    p.dirichlet
-        .push(fixed(mesh.node_sets["bottom"].clone(), [true; 3]));
-    p.dirichlet.push(Dirichlet {
-        nodes: mesh.node_sets["top"].clone(),
-        components: [true; 3],
-        translation: [ramp(0.6), Table::constant(0.0), Table::constant(0.0)],
-        rotation: None,
-    });
-    let s = solve(p);
     let disc = Discretisation::with_formulations(&[(&mesh, material)], &[ANP]).unwrap();
     let (nodal, element) = volume_change(&disc, &s.state.u);
     eprintln!("large shear, ν = {NU}: max |J_a − 1| = {nodal:.2e}, max |J̄_e − 1| = {element:.2e}");
@@ -195,7 +179,7 @@ fn cantilever(ny: usize, element: Formulation) -> f64 {
 }
 
 fn cantilever_nu(ny: usize, element: Formulation, nu: f64) -> f64 {
-    plane_strain_cantilever(ny, true, element, nu, NU)
+    cantilever_beam(ny, true, element, nu, Section::PlaneStrain { nu_load: NU })
 }
 
 #[test]
@@ -242,32 +226,7 @@ fn tet_cantilever_does_not_lock() {
 /// A 3-D cantilever, square section h × h, L = 10 h, sides free, clamped at x = 0, a small
 /// tip shear load; returns the tip deflection per Euler-Bernoulli PL³/(3EI).
 fn cantilever_3d(ny: usize, element: Formulation, tets: bool) -> f64 {
-    let (l, h, e) = (1.0, 0.1, 1.0e6);
-    let mut mesh = generate::block([l, h, h], [10 * ny, ny, ny]);
-    if tets {
-        mesh = mesh.split_hexes_into_tets();
-    }
-    let material = UncoupledNeoHookean::from_young_poisson(e, NU);
-    let mut p = one_body(
-        mesh.clone(),
-        Arc::new(material),
-        1000.0,
-        quasi_static(1.0, 1.0),
-    );
-    p.bodies[0].element = element;
-    p.time.newton_tol = 1e-10;
-    p.dirichlet
-        .push(fixed(mesh.node_sets["left"].clone(), [true, true, true]));
-    let right = mesh.node_sets["right"].clone();
-    let inertia = h * h.powi(3) / 12.0;
-    let p_tip = 1e-3 * l * 3.0 * e * inertia / l.powi(3);
-    p.loads.push(NodalLoad {
-        nodes: right.clone(),
-        total_force: [Table::constant(0.0), ramp(-p_tip), Table::constant(0.0)],
-    });
-    let s = solve(p);
-    let tip = right.iter().map(|&n| s.state.u[3 * n + 1]).sum::<f64>() / right.len() as f64;
-    -tip / (1e-3 * l)
+    cantilever_beam(ny, tets, element, NU, Section::Square)
 }
 
 #[test]

@@ -124,21 +124,36 @@ pub fn homogeneous_patch_error(mesh: &Mesh, boundary: &[usize], element: Formula
     err
 }
 
-/// A plane-strain cantilever (L = 1 m, h = 0.1 m, slab one element thick, `ny` elements
-/// through the height and 10 `ny` along, hexahedra or each split into tetrahedra) of a
-/// neo-Hookean material with E = 1 MPa and Poisson ratio `nu`, clamped at x = 0, under a
-/// tip load that gives δ = 1e-3 L by Euler-Bernoulli for E′ = E/(1 − `nu_load`²). Returns the
-/// mean tip deflection in units of 1e-3 L (1 is Euler-Bernoulli's answer when
-/// `nu_load` = `nu`).
-pub fn plane_strain_cantilever(
+/// The cross-section of [`cantilever_beam`].
+#[derive(Clone, Copy)]
+pub enum Section {
+    /// A slab one element thick with every node held out of plane; the tip load aims at
+    /// Euler-Bernoulli's δ = 1e-3 L for E′ = E/(1 − ν_load²).
+    PlaneStrain { nu_load: f64 },
+    /// A square h × h section with free sides (`ny` elements across each way); the tip load
+    /// aims at δ = 1e-3 L for E.
+    Square,
+}
+
+/// A cantilever (L = 1 m, h = 0.1 m, `ny` elements through the height and 10 `ny` along,
+/// hexahedra or each split into tetrahedra) of a neo-Hookean material with E = 1 MPa and
+/// Poisson ratio `nu`, clamped at x = 0, under a small tip shear load (linear regime).
+/// Returns the mean tip deflection in units of 1e-3 L (1 is Euler-Bernoulli's answer, for a
+/// plane-strain section when `nu_load` = `nu`).
+pub fn cantilever_beam(
     ny: usize,
     tets: bool,
     element: Formulation,
     nu: f64,
-    nu_load: f64,
+    section: Section,
 ) -> f64 {
     let (l, h, e) = (1.0, 0.1, 1.0e6);
-    let mut mesh = generate::block([l, h, h / ny as f64], [10 * ny, ny, 1]);
+    // Plane strain bends with E′ = E/(1 − ν²).
+    let (depth, nz, plane_strain_factor) = match section {
+        Section::PlaneStrain { nu_load } => (h / ny as f64, 1, 1.0 - nu_load * nu_load),
+        Section::Square => (h, ny, 1.0),
+    };
+    let mut mesh = generate::block([l, h, depth], [10 * ny, ny, nz]);
     if tets {
         mesh = mesh.split_hexes_into_tets();
     }
@@ -151,14 +166,18 @@ pub fn plane_strain_cantilever(
     );
     p.bodies[0].element = element;
     p.time.newton_tol = 1e-10;
-    p.dirichlet
-        .push(fixed((0..mesh.num_nodes()).collect(), [false, false, true]));
-    p.dirichlet
-        .push(fixed(mesh.node_sets["left"].clone(), [true, true, false]));
+    let left = mesh.node_sets["left"].clone();
+    match section {
+        Section::PlaneStrain { .. } => {
+            p.dirichlet
+                .push(fixed((0..mesh.num_nodes()).collect(), [false, false, true]));
+            p.dirichlet.push(fixed(left, [true, true, false]));
+        }
+        Section::Square => p.dirichlet.push(fixed(left, [true, true, true])),
+    }
     let right = mesh.node_sets["right"].clone();
-    let depth = h / ny as f64;
     let inertia = depth * h.powi(3) / 12.0;
-    let p_tip = 1e-3 * l * 3.0 * e / (1.0 - nu_load * nu_load) * inertia / l.powi(3);
+    let p_tip = 1e-3 * l * 3.0 * e / plane_strain_factor * inertia / l.powi(3);
     p.loads.push(NodalLoad {
         nodes: right.clone(),
         total_force: [Table::constant(0.0), ramp(-p_tip), Table::constant(0.0)],
@@ -166,4 +185,29 @@ pub fn plane_strain_cantilever(
     let s = solve(p);
     let tip = right.iter().map(|&n| s.state.u[3 * n + 1]).sum::<f64>() / right.len() as f64;
     -tip / (1e-3 * l)
+}
+
+/// A unit cube `mesh` of elements `element` and a nearly incompressible neo-Hookean material
+/// (E = 1 MPa, Poisson ratio `nu`): bottom clamped, top moved sideways by 0.6 (shear strain
+/// 0.6) with its height held, sides free, in four quasi-static increments. Returns the
+/// solved stepper.
+pub fn sheared_block(mesh: &Mesh, element: Formulation, nu: f64) -> Stepper {
+    let material = UncoupledNeoHookean::from_young_poisson(1.0e6, nu);
+    let mut p = one_body(
+        mesh.clone(),
+        Arc::new(material),
+        1000.0,
+        quasi_static(1.0, 0.25),
+    );
+    p.bodies[0].element = element;
+    p.time.newton_tol = 1e-10;
+    p.dirichlet
+        .push(fixed(mesh.node_sets["bottom"].clone(), [true; 3]));
+    p.dirichlet.push(Dirichlet {
+        nodes: mesh.node_sets["top"].clone(),
+        components: [true; 3],
+        translation: [ramp(0.6), Table::constant(0.0), Table::constant(0.0)],
+        rotation: None,
+    });
+    solve(p)
 }

@@ -13,7 +13,7 @@ use adhesim::fbar::volume_ratio;
 use adhesim::fbar::Formulation;
 use adhesim::material::UncoupledNeoHookean;
 use adhesim::mesh::{generate, Mesh};
-use adhesim::problem::{Dirichlet, NodalLoad, Problem, Table};
+use adhesim::problem::{NodalLoad, Problem, Table};
 use adhesim::time::Stepper;
 use std::sync::Arc;
 
@@ -36,7 +36,7 @@ fn mean_of(s: &Stepper, nodes: &[usize], k: usize) -> f64 {
 /// free end (tip deflection ~ 1e-3 L, linear regime); `ny` elements through the thickness,
 /// 10·ny along. Returns the mean tip deflection in units of the Euler-Bernoulli value.
 fn cantilever(ny: usize, element: Formulation) -> f64 {
-    plane_strain_cantilever(ny, false, element, NU, NU)
+    cantilever_beam(ny, false, element, NU, Section::PlaneStrain { nu_load: NU })
 }
 
 #[test]
@@ -166,27 +166,8 @@ fn volume_change(s: &Stepper, mesh: &Mesh) -> f64 {
 
 #[test]
 fn block_under_large_shear_keeps_its_volume() {
-    // Unit cube, bottom clamped, top moved sideways by 0.6 (shear strain 0.6) with its
-    // height held; sides free.
     let mesh = generate::block([1.0, 1.0, 1.0], [4, 4, 4]);
-    let material = UncoupledNeoHookean::from_young_poisson(1.0e6, NU);
-    let mut p = one_body(
-        mesh.clone(),
-        Arc::new(material),
-        1000.0,
-        quasi_static(1.0, 0.25),
-    );
-    p.bodies[0].element = Formulation::FBar;
-    p.time.newton_tol = 1e-10;
-    p.dirichlet
-        .push(fixed(mesh.node_sets["bottom"].clone(), [true; 3]));
-    p.dirichlet.push(Dirichlet {
-        nodes: mesh.node_sets["top"].clone(),
-        components: [true; 3],
-        translation: [ramp(0.6), Table::constant(0.0), Table::constant(0.0)],
-        rotation: None,
-    });
-    let s = solve(p);
+    let s = sheared_block(&mesh, Formulation::FBar, NU);
     let dv = volume_change(&s, &mesh);
     eprintln!("large shear, ν = {NU}: max |J − 1| = {dv:.2e}");
     // κ/μ = 5000: the pressure, of the order of μ, changes the volume by ~2e-4.
