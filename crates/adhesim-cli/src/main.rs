@@ -317,13 +317,7 @@ fn check(path: &Path, opts: &adhesim::scenario::LoadOptions) -> ExitCode {
         Ok(p) => p,
         Err(e) => return fail_input(e),
     };
-    let bodies: Vec<_> = problem
-        .bodies
-        .iter()
-        .map(|b| (&b.mesh, b.material.clone()))
-        .collect();
-    if let Err(bad) = adhesim::assembly::Discretisation::new(&bodies) {
-        let err = adhesim::time::SetupError::BadElements(bad);
+    if let Err(err) = adhesim::time::check_elements(&problem) {
         return fail_input(format!("{}: {err}", path.display()));
     }
     for w in adhesim::warnings::physical_warnings(&problem) {

@@ -59,13 +59,7 @@ fn load(
     let options = load_options(variant, overrides)?;
     let problem = adhesim::scenario::parse_with(text, path, &options)
         .map_err(|e| ScenarioError::new_err(e.to_string()))?;
-    let bodies: Vec<_> = problem
-        .bodies
-        .iter()
-        .map(|b| (&b.mesh, b.material.clone()))
-        .collect();
-    if let Err(bad) = adhesim::assembly::Discretisation::new(&bodies) {
-        let err = adhesim::time::SetupError::BadElements(bad);
+    if let Err(err) = adhesim::time::check_elements(&problem) {
         return Err(ScenarioError::new_err(format!("{}: {err}", path.display())));
     }
     Ok(problem)

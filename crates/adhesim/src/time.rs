@@ -41,6 +41,19 @@ pub enum SetupError {
     Linalg(#[from] LinalgError),
 }
 
+/// Checks the reference meshes of `problem` for degenerate or inverted elements (what
+/// [`Stepper::new`] would refuse), without building the system matrix.
+pub fn check_elements(problem: &Problem) -> Result<(), SetupError> {
+    let bodies: Vec<_> = problem
+        .bodies
+        .iter()
+        .map(|b| (&b.mesh, b.material.clone()))
+        .collect();
+    Discretisation::new(&bodies)
+        .map(|_| ())
+        .map_err(SetupError::BadElements)
+}
+
 fn describe_bad(bad: &[BadElement]) -> String {
     let mut s: Vec<String> = bad
         .iter()
