@@ -285,6 +285,8 @@ struct Attempt {
     internal: f64,
     work: f64,
     points: Vec<ContactPoint>,
+    /// Committed bond state of each candidate at the start of the step (local frames).
+    bond0: Vec<BondState>,
     solutions: Vec<PointSolution>,
     sweeps: usize,
     contact_residual: f64,
@@ -497,7 +499,7 @@ impl Stepper {
             }
             match self.attempt(dt) {
                 Ok(a) => {
-                    self.commit_contact(&a.points, &a.solutions);
+                    self.commit_contact(&a.points, &a.solutions, &a.bond0);
                     self.reactions = a.reactions;
                     let (contact_sweeps, contact_points, timings, contact_residual) =
                         (a.sweeps, a.points.len(), a.timings, a.contact_residual);
@@ -552,8 +554,12 @@ impl Stepper {
         }
     }
 
-    fn commit_contact(&mut self, points: &[ContactPoint], sols: &[PointSolution]) {
-        let bond0 = self.bonds_at_start(points);
+    fn commit_contact(
+        &mut self,
+        points: &[ContactPoint],
+        sols: &[PointSolution],
+        bond0: &[BondState],
+    ) {
         // Nodes that are not candidates of this step lose their bond (β = 0); what they
         // dissipated stays.
         for (nodes, pair) in self.contact.iter_mut().zip(&self.problem.contacts) {

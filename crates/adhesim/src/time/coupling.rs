@@ -71,6 +71,14 @@ impl<'a> StepContact<'a> {
 }
 
 impl StepContact<'_> {
+    /// The candidates and their bond state at the start of the step, handed back at its end.
+    pub fn take_candidates(&mut self) -> (Vec<ContactPoint>, Vec<BondState>) {
+        (
+            std::mem::take(&mut self.points),
+            std::mem::take(&mut self.bond0),
+        )
+    }
+
     /// True when the step has no contact candidate.
     pub fn is_empty(&self) -> bool {
         self.points.is_empty()
@@ -181,6 +189,4 @@ pub trait ContactCoupling<'a> {
     }
     /// The step failed: drop whatever must not be reused.
     fn abandon(&mut self) {}
-    /// The candidates, handed back at the end of the step.
-    fn take_points(&mut self) -> Vec<ContactPoint>;
 }

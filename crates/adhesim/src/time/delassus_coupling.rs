@@ -220,10 +220,6 @@ impl<'a> ContactCoupling<'a> for DelassusCoupling<'a> {
     fn abandon(&mut self) {
         *self.cache = None;
     }
-
-    fn take_points(&mut self) -> Vec<ContactPoint> {
-        std::mem::take(&mut self.sc.points)
-    }
 }
 
 /// What W depends on besides K̄: the contact points (pair, node, frame, master weights) and

@@ -5,7 +5,6 @@
 
 use super::coupling::{ContactCoupling, Evaluated, Iterate, StepContact};
 use super::PhaseTimes;
-use crate::contact::detect::ContactPoint;
 use crate::contact::law::{ContactState, PointSolution};
 use crate::contact::newton::{self, augmented_point, AugmentedPoint};
 use crate::system::SystemMatrix;
@@ -211,9 +210,5 @@ impl<'a> ContactCoupling<'a> for NewtonCoupling<'a> {
 
     fn sweeps(&self) -> usize {
         self.updates
-    }
-
-    fn take_points(&mut self) -> Vec<ContactPoint> {
-        std::mem::take(&mut self.sc.points)
     }
 }

@@ -156,6 +156,7 @@ impl<'a> NewtonLoop<'a> {
     /// Stage *commit* (what the step hands back): the converged iterate `u` with its end
     /// velocity, work, forces and contact solution.
     fn finish(&mut self, u: &[f64], asm: Assembled, check: Check) -> Attempt {
+        let (points, bond0) = self.coupling.step_contact().take_candidates();
         let force = self.coupling.contact_force();
         Attempt {
             work: self.step.work(u, &check.reactions, force),
@@ -172,7 +173,8 @@ impl<'a> NewtonLoop<'a> {
             delassus_builds: self.coupling.delassus_builds(),
             timings: self.timings,
             reactions: check.reactions,
-            points: self.coupling.take_points(),
+            points,
+            bond0,
         }
     }
 }
