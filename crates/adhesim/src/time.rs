@@ -174,10 +174,8 @@ impl NodeContact {
             self.tangent_axes.as_flattened(),
             &[self.damage],
         ];
-        let mut k = 0;
-        for x in parts.into_iter().flatten() {
-            v[k] = *x;
-            k += 1;
+        for (slot, x) in v.iter_mut().zip(parts.into_iter().flatten()) {
+            *slot = *x;
         }
         v
     }
