@@ -4,7 +4,7 @@
 //! then checks values (positive moduli, time step, existing node sets, ...) and names the key
 //! that is wrong and what would be valid. The format is documented in `docs/scenario.md`.
 
-use crate::contact::detect::tributary_areas;
+use crate::contact::detect::{thickness_twins, tributary_areas};
 use crate::contact::law::{Orthotropy, DEFAULT_BETA_EPS};
 use crate::contact::{ContactPair, InterfaceLaw, Master, RccParams, RigidMotion, RigidShape};
 use crate::material::{self, Hyperelastic};
@@ -671,6 +671,7 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
         }
         loads.push(NodalLoad { nodes, total_force });
     }
+    let plane_strain: Vec<bool> = raw.bodies.iter().map(|b| b.plane_strain).collect();
     let mut contacts = Vec::new();
     for (i, c) in raw.contacts.iter().enumerate() {
         contacts.push(build_contact(
@@ -679,6 +680,7 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
             &bodies,
             &body_index,
             &offsets,
+            &plane_strain,
             ctx,
         )?);
     }
@@ -1406,6 +1408,7 @@ fn build_contact(
     bodies: &[Body],
     body_index: &BTreeMap<String, usize>,
     offsets: &[usize],
+    plane_strain: &[bool],
     ctx: &Ctx,
 ) -> Result<ContactPair, ScenarioError> {
     if c.name.is_empty() || c.name.contains([',', '"', '\n', '.']) {
@@ -1646,6 +1649,16 @@ fn build_contact(
             })
         }
     };
+    // A plane-strain slave against a plane-strain body or a rigid surface is a plane problem:
+    // each line of slave nodes through the thickness is one contact point.
+    let master_in_plane = m.body.as_ref().map_or(true, |b| {
+        body_index.get(b).is_some_and(|&i| plane_strain[i])
+    });
+    let thickness_twins = if plane_strain[sb] && master_in_plane {
+        thickness_twins(&local_nodes, &bodies[sb].mesh.nodes)
+    } else {
+        vec![Vec::new(); local_nodes.len()]
+    };
     let detection_distance = match c.detection_distance {
         Some(d) => ctx.positive(&format!("{key}.detection_distance"), d)?,
         None => 0.5 * mean_edge,
@@ -1662,5 +1675,6 @@ fn build_contact(
         },
         detection_distance,
         slave_quads,
+        thickness_twins,
     })
 }

@@ -583,12 +583,15 @@ impl Stepper {
                 Some(a) => accumulated_damage(b0.damage, b0.beta, sol.beta, a),
                 None => b0.damage,
             };
-            self.contact[pt.pair][pt.local] = NodeContact {
+            // Each slave node of the point carries its share of the forces.
+            let share = pt.node_share();
+            let part = |v: [f64; 3]| v.map(|c| share * c);
+            let node = NodeContact {
                 beta: sol.beta,
                 ut: global([sol.ut[0], sol.ut[1], 0.0]),
-                r_dry: sol.r_dry,
-                r_adh: sol.r_adh,
-                force: global(r),
+                r_dry: part(sol.r_dry),
+                r_adh: part(sol.r_adh),
+                force: part(global(r)),
                 gap: sol.x[2],
                 slip: [sol.x[0], sol.x[1]],
                 state: match sol.state {
@@ -599,6 +602,9 @@ impl Stepper {
                 tangent_axes: [f[0], f[1]],
                 damage,
             };
+            for local in pt.locals() {
+                self.contact[pt.pair][local] = node;
+            }
         }
     }
 
@@ -647,9 +653,10 @@ impl Stepper {
                 }
                 let [t1, t2] = c.tangent_axes;
                 let n = crate::contact::detect::cross(t1, t2);
-                let g: [f64; 3] = std::array::from_fn(|k| {
-                    c.r_dry[0] * t1[k] + c.r_dry[1] * t2[k] + c.r_dry[2] * n[k]
-                });
+                // The node holds its share of the point's force.
+                let r = c.r_dry.map(|v| v / pt.node_share());
+                let g: [f64; 3] =
+                    std::array::from_fn(|k| r[0] * t1[k] + r[1] * t2[k] + r[2] * n[k]);
                 pt.frame
                     .map(|axis| axis[0] * g[0] + axis[1] * g[1] + axis[2] * g[2])
             })

@@ -284,6 +284,7 @@ fn indent_on(
             // The no-penetration check below covers every surface node, candidate or not.
             detection_distance: detection,
             slave_quads: vec![],
+            thickness_twins: vec![],
         }],
         tracks: vec![],
         output: OutputSettings {

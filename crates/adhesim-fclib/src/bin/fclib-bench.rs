@@ -114,6 +114,7 @@ fn nsgs_dense(p: &ReducedProblem, del: &Delassus, tol: f64, max_iter: usize) -> 
             master: Vec::new(),
             master_point_end: [0.0; 3],
             d0: [0.0; 3],
+            twins: Vec::new(),
         })
         .collect();
     let laws: Vec<InterfaceLaw> =

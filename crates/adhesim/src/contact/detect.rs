@@ -111,6 +111,33 @@ pub struct ContactPair {
     /// Faces of the slave surface as indices into `slave_nodes` (a triangle repeats its
     /// last node), for maps of contact fields over the surface.
     pub slave_quads: Vec<[usize; 4]>,
+    /// Plane strain: for each slave node, the other slave nodes on its line through the
+    /// slab's thickness (same x and y), as indices into `slave_nodes`; empty lists for a 3D
+    /// pair. Such a line is one contact point of the plane problem (see [`ContactPoint`]).
+    pub thickness_twins: Vec<Vec<usize>>,
+}
+
+/// For a plane-strain slave surface (the plane being x-y): each node's twins, the other nodes
+/// of `nodes` with the same reference x and y (to 1e-9 of the surface's extent).
+pub fn thickness_twins(nodes: &[usize], coords: &[[f64; 3]]) -> Vec<Vec<usize>> {
+    let extent = nodes
+        .iter()
+        .flat_map(|&n| coords[n][..2].iter().map(|c| c.abs()))
+        .fold(0.0f64, f64::max);
+    let tol = 1e-9 * extent.max(f64::MIN_POSITIVE);
+    let key = |n: usize| {
+        let c = coords[n];
+        ((c[0] / tol).round() as i64, (c[1] / tol).round() as i64)
+    };
+    let mut lines: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+    for (i, &n) in nodes.iter().enumerate() {
+        lines.entry(key(n)).or_default().push(i);
+    }
+    nodes
+        .iter()
+        .enumerate()
+        .map(|(i, &n)| lines[&key(n)].iter().copied().filter(|&j| j != i).collect())
+        .collect()
 }
 
 /// Tributary areas of the nodes of a face set: each face's area split equally among its
@@ -159,9 +186,34 @@ pub struct ContactPoint {
     pub master_point_end: [f64; 3],
     /// Relative position slave − master at the start of the step, in global axes [m].
     pub d0: [f64; 3],
+    /// Plane strain: the other slave nodes through the slab's thickness (global node, index in
+    /// the pair), empty in 3D. The point then stands for the whole line: its slave
+    /// displacement is the mean over `slave` and its twins, its force is shared equally
+    /// among them, and its area is theirs together, so that the slab cannot be twisted out
+    /// of its plane by contact.
+    pub twins: Vec<(usize, usize)>,
 }
 
 impl ContactPoint {
+    /// The slave nodes with their weights in the point's slave displacement: the node alone
+    /// (weight 1), or the node and its twins through a plane-strain slab (equal weights).
+    pub fn slave_nodes(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let w = 1.0 / (1 + self.twins.len()) as f64;
+        std::iter::once(self.slave)
+            .chain(self.twins.iter().map(|t| t.0))
+            .map(move |s| (s, w))
+    }
+
+    /// Indices in the pair of the slave nodes the point stands for.
+    pub fn locals(&self) -> impl Iterator<Item = usize> + '_ {
+        std::iter::once(self.local).chain(self.twins.iter().map(|t| t.1))
+    }
+
+    /// The weight of each slave node in the point (1 in 3D, 1/n for a line of n nodes through
+    /// a plane-strain slab): the share of the point's force each node carries.
+    pub fn node_share(&self) -> f64 {
+        1.0 / (1 + self.twins.len()) as f64
+    }
     /// Local relative displacement x = (slip increment t₁, t₂, end gap n) for the end-of-step
     /// displacement `u` [m] (H applied to u plus the constant part).
     pub fn local_x(&self, reference: &[[f64; 3]], u: &[f64]) -> [f64; 3] {
@@ -172,8 +224,12 @@ impl ContactPoint {
     }
 
     fn relative_position(&self, reference: &[[f64; 3]], u: &[f64]) -> [f64; 3] {
-        let s = self.slave;
-        let xs: [f64; 3] = std::array::from_fn(|k| reference[s][k] + u[3 * s + k]);
+        let mut xs = [0.0; 3];
+        for (s, w) in self.slave_nodes() {
+            for k in 0..3 {
+                xs[k] += w * (reference[s][k] + u[3 * s + k]);
+            }
+        }
         if self.master.is_empty() {
             return sub(xs, self.master_point_end);
         }
@@ -190,8 +246,10 @@ impl ContactPoint {
     pub fn add_ht(&self, r: [f64; 3], out: &mut [f64]) {
         let f = &self.frame;
         let g: [f64; 3] = std::array::from_fn(|k| r[0] * f[0][k] + r[1] * f[1][k] + r[2] * f[2][k]);
-        for k in 0..3 {
-            out[3 * self.slave + k] += g[k];
+        for (s, ws) in self.slave_nodes() {
+            for k in 0..3 {
+                out[3 * s + k] += ws * g[k];
+            }
         }
         for &(m, w) in &self.master {
             for k in 0..3 {
@@ -202,8 +260,12 @@ impl ContactPoint {
 
     /// H v: the local components of a global displacement field v.
     pub fn apply_h(&self, v: &[f64]) -> [f64; 3] {
-        let s = self.slave;
-        let mut d: [f64; 3] = std::array::from_fn(|k| v[3 * s + k]);
+        let mut d = [0.0; 3];
+        for (s, ws) in self.slave_nodes() {
+            for k in 0..3 {
+                d[k] += ws * v[3 * s + k];
+            }
+        }
         for &(m, w) in &self.master {
             for k in 0..3 {
                 d[k] -= w * v[3 * m + k];
@@ -215,7 +277,8 @@ impl ContactPoint {
 }
 
 /// Detects the contact points of all pairs at the start of a step [t0, t1] from the
-/// displacement `u0`.
+/// displacement `u0`. On a plane-strain slave surface the nodes of one line through the
+/// slab's thickness make one point when all of them are candidates ([`ContactPoint::twins`]).
 pub fn detect(
     pairs: &[ContactPair],
     reference: &[[f64; 3]],
@@ -226,72 +289,170 @@ pub fn detect(
     let pos = |n: usize| -> [f64; 3] { std::array::from_fn(|k| reference[n][k] + u0[3 * n + k]) };
     let mut out = Vec::new();
     for (pi, pair) in pairs.iter().enumerate() {
-        match &pair.master {
-            Master::Rigid { shape, motion } => {
-                for (li, &s) in pair.slave_nodes.iter().enumerate() {
-                    let xs = pos(s);
-                    // Work in the surface's reference frame.
-                    let xr = motion.inverse(xs, t0);
-                    let (proj, normal, gap) = rigid_projection(shape, xr);
-                    if gap > pair.detection_distance {
-                        continue;
-                    }
-                    let p0 = motion.apply(proj, t0);
-                    let n0 = motion.rotate_dir(normal, t0);
-                    out.push(ContactPoint {
-                        pair: pi,
-                        local: li,
-                        slave: s,
-                        area: pair.slave_area[li],
-                        frame: frame_from_normal(n0),
-                        master: Vec::new(),
-                        master_point_end: motion.apply(proj, t1),
-                        d0: sub(xs, p0),
-                    });
-                }
+        let grid = match &pair.master {
+            Master::Faces(faces) => Some(FaceGrid::new(faces, &pos, pair.detection_distance)),
+            Master::Rigid { .. } => None,
+        };
+        let project = |li: usize| project_slave(pair, grid.as_ref(), &pos, li, t0, t1);
+        for li in 0..pair.slave_nodes.len() {
+            let twins = pair.thickness_twins.get(li).map_or(&[][..], |t| &t[..]);
+            if twins.is_empty() {
+                out.extend(project(li).map(|p| p.point(pi, pair, li)));
+                continue;
             }
-            Master::Faces(faces) => {
-                let grid = FaceGrid::new(faces, &pos, pair.detection_distance);
-                for (li, &s) in pair.slave_nodes.iter().enumerate() {
-                    let xs = pos(s);
-                    let mut best: Option<(f64, [f64; 3], Vec<(usize, f64)>, [f64; 3])> = None;
-                    for &fi in grid.candidates(xs) {
-                        let face = &faces[fi];
-                        if face.nodes().contains(&s) {
-                            continue;
-                        }
-                        let (xm, normal, weights) = project_on_face(face, &pos, xs);
-                        let d = sub(xs, xm);
-                        let dist = norm(d);
-                        let gap = dot(d, normal);
-                        // Accept points on the outer side (or slightly penetrated) whose
-                        // projection is close to the face.
-                        if dist > pair.detection_distance || gap < -pair.detection_distance {
-                            continue;
-                        }
-                        if best.as_ref().map_or(true, |b| dist < b.0) {
-                            let nodes: Vec<(usize, f64)> =
-                                face.nodes().iter().copied().zip(weights).collect();
-                            best = Some((dist, normal, nodes, xm));
-                        }
-                    }
-                    if let Some((_, normal, master, xm)) = best {
-                        out.push(ContactPoint {
-                            pair: pi,
-                            local: li,
-                            slave: s,
-                            area: pair.slave_area[li],
-                            frame: frame_from_normal(normal),
-                            master,
-                            master_point_end: xm,
-                            d0: sub(xs, xm),
-                        });
-                    }
+            // The line's first node stands for it.
+            if twins.iter().any(|&j| j < li) {
+                continue;
+            }
+            let line: Vec<usize> = std::iter::once(li).chain(twins.iter().copied()).collect();
+            let found: Vec<Option<Projection>> = line.iter().map(|&l| project(l)).collect();
+            if found.iter().all(Option::is_some) {
+                let found: Vec<Projection> = found.into_iter().flatten().collect();
+                out.push(line_point(pi, pair, &line, &found));
+            } else {
+                for (&l, p) in line.iter().zip(found) {
+                    out.extend(p.map(|p| p.point(pi, pair, l)));
                 }
             }
         }
     }
     out
+}
+
+/// A slave node's closest point on the master surface at the start of a step.
+struct Projection {
+    /// Unit normal of the master surface there (towards the slave side).
+    normal: [f64; 3],
+    /// Master nodes and weights (empty for a rigid master).
+    master: Vec<(usize, f64)>,
+    /// Slave node position at the start of the step [m].
+    slave: [f64; 3],
+    /// Master point at the start of the step [m].
+    start: [f64; 3],
+    /// Master point at the end of the step (rigid) or at its start (deformable) [m].
+    end: [f64; 3],
+}
+
+impl Projection {
+    /// The contact point of this node alone.
+    fn point(self, pair_index: usize, pair: &ContactPair, local: usize) -> ContactPoint {
+        ContactPoint {
+            pair: pair_index,
+            local,
+            slave: pair.slave_nodes[local],
+            area: pair.slave_area[local],
+            frame: frame_from_normal(self.normal),
+            master: self.master,
+            master_point_end: self.end,
+            d0: sub(self.slave, self.start),
+            twins: Vec::new(),
+        }
+    }
+}
+
+/// The projection of slave node `local` of `pair`, if it is a candidate: within the detection
+/// distance of the master surface and not too far behind it.
+fn project_slave(
+    pair: &ContactPair,
+    grid: Option<&FaceGrid>,
+    pos: &dyn Fn(usize) -> [f64; 3],
+    local: usize,
+    t0: f64,
+    t1: f64,
+) -> Option<Projection> {
+    let s = pair.slave_nodes[local];
+    let xs = pos(s);
+    match &pair.master {
+        Master::Rigid { shape, motion } => {
+            // Work in the surface's reference frame.
+            let xr = motion.inverse(xs, t0);
+            let (proj, normal, gap) = rigid_projection(shape, xr);
+            if gap > pair.detection_distance {
+                return None;
+            }
+            Some(Projection {
+                normal: motion.rotate_dir(normal, t0),
+                master: Vec::new(),
+                slave: xs,
+                start: motion.apply(proj, t0),
+                end: motion.apply(proj, t1),
+            })
+        }
+        Master::Faces(faces) => {
+            let grid = grid.expect("a face grid for a master made of faces");
+            let mut best: Option<(f64, [f64; 3], Vec<(usize, f64)>, [f64; 3])> = None;
+            for &fi in grid.candidates(xs) {
+                let face = &faces[fi];
+                if face.nodes().contains(&s) {
+                    continue;
+                }
+                let (xm, normal, weights) = project_on_face(face, pos, xs);
+                let d = sub(xs, xm);
+                let dist = norm(d);
+                let gap = dot(d, normal);
+                // Accept points on the outer side (or slightly penetrated) whose projection
+                // is close to the face.
+                if dist > pair.detection_distance || gap < -pair.detection_distance {
+                    continue;
+                }
+                if best.as_ref().map_or(true, |b| dist < b.0) {
+                    let nodes: Vec<(usize, f64)> =
+                        face.nodes().iter().copied().zip(weights).collect();
+                    best = Some((dist, normal, nodes, xm));
+                }
+            }
+            best.map(|(_, normal, master, xm)| Projection {
+                normal,
+                master,
+                slave: xs,
+                start: xm,
+                end: xm,
+            })
+        }
+    }
+}
+
+/// One contact point for the nodes `line` (indices in `pair`) through a plane-strain slab,
+/// from their projections: mean positions, master weights shared equally, the normal of the
+/// mean projection kept in the x-y plane, the nodes' areas together.
+fn line_point(
+    pair_index: usize,
+    pair: &ContactPair,
+    line: &[usize],
+    found: &[Projection],
+) -> ContactPoint {
+    let share = 1.0 / line.len() as f64;
+    let mean = |f: &dyn Fn(&Projection) -> [f64; 3]| -> [f64; 3] {
+        std::array::from_fn(|k| found.iter().map(|p| share * f(p)[k]).sum())
+    };
+    let normal = mean(&|p| p.normal);
+    let in_plane = [normal[0], normal[1], 0.0];
+    let normal = if norm(in_plane) > 0.0 {
+        normalize(in_plane)
+    } else {
+        normalize(normal)
+    };
+    let mut master: Vec<(usize, f64)> = Vec::new();
+    for (m, w) in found.iter().flat_map(|p| p.master.iter().copied()) {
+        match master.iter_mut().find(|e| e.0 == m) {
+            Some(e) => e.1 += share * w,
+            None => master.push((m, share * w)),
+        }
+    }
+    ContactPoint {
+        pair: pair_index,
+        local: line[0],
+        slave: pair.slave_nodes[line[0]],
+        area: line.iter().map(|&l| pair.slave_area[l]).sum(),
+        frame: frame_from_normal(normal),
+        master,
+        master_point_end: mean(&|p| p.end),
+        d0: sub(mean(&|p| p.slave), mean(&|p| p.start)),
+        twins: line[1..]
+            .iter()
+            .map(|&l| (pair.slave_nodes[l], l))
+            .collect(),
+    }
 }
 
 /// Closest point, outward unit normal and signed gap of a point (in the surface's

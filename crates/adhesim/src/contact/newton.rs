@@ -182,8 +182,9 @@ pub fn augmented_point(
 }
 
 /// Upper bound of the stiffness [N/m] that K̄ shows at a contact point: 1/(e K̄⁻¹ e) ≤ e K̄ e
-/// along any unit direction e, taken as 1/(1/k_s + Σ_m w_m²/k_m) from the largest free diagonal
-/// entry of K̄ at the slave node (k_s) and at each master node (k_m). `diagonal` holds K̄_ii;
+/// along any unit direction e, taken as 1/(Σ_s w_s²/k_s + Σ_m w_m²/k_m) from the largest free
+/// diagonal entry of K̄ at each slave node (k_s, weight w_s: 1, or shared along a plane-strain
+/// line) and at each master node (k_m). `diagonal` holds K̄_ii;
 /// constrained unknowns are skipped. Returns `None` when every unknown involved is constrained.
 pub fn point_stiffness(pt: &ContactPoint, diagonal: &[f64], constrained: &[bool]) -> Option<f64> {
     let node_k = |n: usize| -> Option<f64> {
@@ -193,8 +194,8 @@ pub fn point_stiffness(pt: &ContactPoint, diagonal: &[f64], constrained: &[bool]
             .filter(|v| v.is_finite() && *v > 0.0)
             .reduce(f64::max)
     };
-    let mut compliance = node_k(pt.slave).map_or(0.0, |k| 1.0 / k);
-    for &(m, w) in &pt.master {
+    let mut compliance = 0.0;
+    for (m, w) in pt.slave_nodes().chain(pt.master.iter().copied()) {
         if let Some(k) = node_k(m) {
             compliance += w * w / k;
         }
@@ -206,11 +207,13 @@ pub fn point_stiffness(pt: &ContactPoint, diagonal: &[f64], constrained: &[bool]
 pub fn couplings(points: &[ContactPoint]) -> Vec<(usize, usize)> {
     let mut pairs = Vec::new();
     for pt in points {
-        for (i, &(m, _)) in pt.master.iter().enumerate() {
-            pairs.push((pt.slave, m));
-            for &(m2, _) in &pt.master[..i] {
-                pairs.push((m, m2));
-            }
+        let nodes: Vec<usize> = pt
+            .slave_nodes()
+            .map(|(s, _)| s)
+            .chain(pt.master.iter().map(|&(m, _)| m))
+            .collect();
+        for (i, &a) in nodes.iter().enumerate() {
+            pairs.extend(nodes[..i].iter().map(|&b| (a, b)));
         }
     }
     pairs
@@ -243,7 +246,8 @@ pub fn add_contact_tangent(
             }
         }
         // H = [I at the slave, −w_m I at master node m] before the rotation.
-        let nodes: Vec<(usize, f64)> = std::iter::once((pt.slave, 1.0))
+        let nodes: Vec<(usize, f64)> = pt
+            .slave_nodes()
             .chain(pt.master.iter().map(|&(m, w)| (m, -w)))
             .collect();
         for &(a, ca) in &nodes {

@@ -229,7 +229,7 @@ fn delassus_key(points: &[ContactPoint], dt: f64) -> Vec<u64> {
     key.push(dt.to_bits());
     for p in points {
         key.push(p.pair as u64);
-        key.push(p.slave as u64);
+        key.extend(p.slave_nodes().map(|(s, _)| s as u64));
         for row in &p.frame {
             key.extend(row.iter().map(|x| x.to_bits()));
         }
