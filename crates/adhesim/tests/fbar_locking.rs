@@ -5,7 +5,8 @@
 //!   answer of the same model (Richardson extrapolation of its own refinements), while full
 //!   integration locks.
 //! - Cook's membrane, plane strain, small load (linear regime): the tip deflection converges,
-//!   the finest mesh within 1 % of the Richardson-extrapolated value.
+//!   and the finest mesh is within 1 % of the converged value computed with CalculiX
+//!   (bench/cook/run.sh).
 //! - A block under large simple shear keeps its volume element by element (|J − 1| < 1e-3).
 //! - A patch test: a homogeneous finite deformation is reproduced on a distorted mesh.
 
@@ -21,6 +22,16 @@ mod common;
 use common::*;
 
 const NU: f64 = 0.4999;
+
+/// Converged vertical displacement of the top right corner (48, 60) of Cook's membrane in
+/// plane strain, E = 250, ν = 0.4999, F = 100 (the problem of `cook`), from
+/// `bench/cook/run.sh`: CalculiX 2.20, C3D20R (quadratic hexahedra, reduced integration) on
+/// 4² … 128² meshes of the same mapping, Richardson extrapolation of 32², 64², 128² with the
+/// observed order 1.09: 7.7709 (64², 128², 256²: 7.7713; C3D20: 7.7714). The order matches the
+/// corner singularity at the clamp (0, 44) (a point value converges as h^(2λ), 2λ = 1.087).
+/// The literature on locking-free elements quotes about 7.7 for this load case
+/// (docs/elements.md).
+const COOK_REFERENCE: f64 = 7.771;
 
 /// Fixes z on every node (plane strain for a slab one element thick).
 fn plane_strain(p: &mut Problem, mesh: &Mesh) {
@@ -137,7 +148,12 @@ fn cooks_membrane_converges() {
             standard.get(i).map_or("-".into(), |v| format!("{v:.4}"))
         );
     }
-    eprintln!("observed order {order:.2}, extrapolated {converged:.4}");
+    let err_ref = (f - COOK_REFERENCE) / COOK_REFERENCE;
+    eprintln!(
+        "observed order {order:.2}, extrapolated {converged:.4}; 64×64 vs the CalculiX \
+         reference {COOK_REFERENCE}: {:+.2} %",
+        100.0 * err_ref
+    );
     assert!(order > 1.0, "order {order}: {fbar:?}");
     // Monotone convergence from below (a stiff element under-predicts).
     for w in fbar.windows(2) {
@@ -145,9 +161,24 @@ fn cooks_membrane_converges() {
     }
     let err = (f - converged).abs() / converged;
     assert!(err < 0.01, "F-bar 64×64: {f} vs {converged} ({err:.4})");
-    // The value quoted for this benchmark by mixed and enhanced-strain elements is ≈ 7.7-7.8
-    // (docs/elements.md); a much different extrapolation would mean a different problem.
-    assert!((7.6..7.9).contains(&converged), "{converged}");
+    // The finest mesh against the reference from a peer code (COOK_REFERENCE), within 1 %.
+    // F-bar is 0.44 % low at 64×64, and no element is expected to be much closer there: the
+    // clamped corner (0, 44) limits every element to h^1.09, so halving h only about halves the
+    // error (C3D20R, quadratic, is still 0.35 % low at 64×64). The rest of the budget covers
+    // what is not discretisation: the reference's own uncertainty (~0.01 %, the spread of its
+    // extrapolations) and the geometric nonlinearity of our finite-strain run (load 1e-4 of
+    // F = 100: ~1e-5 relative).
+    assert!(
+        err_ref.abs() < 0.01,
+        "F-bar 64×64: {f} vs the reference {COOK_REFERENCE} ({:+.2} %)",
+        100.0 * err_ref
+    );
+    // The element's own extrapolation lands on the reference too (0.07 % below it; with the
+    // corner's order 1.09 instead of the observed 1.29 it would be 0.04 % above).
+    assert!(
+        ((converged - COOK_REFERENCE) / COOK_REFERENCE).abs() < 0.005,
+        "extrapolated {converged} vs the reference {COOK_REFERENCE}"
+    );
     // Full integration locks: at 16×16 it is still at a third of the answer.
     assert!(standard[2] < 0.5 * converged, "{standard:?}");
 }
