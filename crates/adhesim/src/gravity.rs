@@ -8,7 +8,7 @@
 //!   `[[t, g], ...]` (linear between points, constant outside), as for loads; a missing
 //!   component is zero.
 
-use crate::problem::Table;
+use crate::prescribed::Table;
 
 /// Gravitational acceleration over time [m/s²], one table per component.
 #[derive(Clone, Debug, PartialEq)]

@@ -20,6 +20,7 @@ pub mod material;
 pub mod mesh;
 pub mod outdir;
 pub mod output;
+pub mod prescribed;
 pub mod problem;
 pub mod run;
 pub mod scenario;

@@ -4,54 +4,8 @@
 
 use crate::material::Hyperelastic;
 use crate::mesh::Mesh;
+pub use crate::prescribed::{rotate, Rotation, Table};
 use std::sync::Arc;
-
-/// A piecewise-linear function of time, constant beyond its first and last points.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Table {
-    /// Strictly increasing times [s].
-    pub t: Vec<f64>,
-    /// Values at those times (unit of the quantity).
-    pub v: Vec<f64>,
-}
-
-impl Table {
-    /// A constant function.
-    pub fn constant(v: f64) -> Self {
-        Table {
-            t: vec![0.0],
-            v: vec![v],
-        }
-    }
-
-    /// Value at time `t`.
-    pub fn at(&self, t: f64) -> f64 {
-        let n = self.t.len();
-        if n == 0 {
-            return 0.0;
-        }
-        if t <= self.t[0] {
-            return self.v[0];
-        }
-        if t >= self.t[n - 1] {
-            return self.v[n - 1];
-        }
-        let k = self.t.partition_point(|&ti| ti <= t);
-        let (t0, t1, v0, v1) = (self.t[k - 1], self.t[k], self.v[k - 1], self.v[k]);
-        v0 + (v1 - v0) * (t - t0) / (t1 - t0)
-    }
-}
-
-/// A prescribed rigid rotation about a fixed axis.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Rotation {
-    /// A point of the axis in the reference configuration [m].
-    pub center: [f64; 3],
-    /// Unit axis direction.
-    pub axis: [f64; 3],
-    /// Rotation angle as a function of time [rad] (right-hand rule about `axis`).
-    pub angle: Table,
-}
 
 /// Prescribed displacement of a node set: u(X, t) = T(t) + (R(t) − I)(X − c).
 #[derive(Clone, Debug, PartialEq)]
@@ -64,19 +18,6 @@ pub struct Dirichlet {
     pub translation: [Table; 3],
     /// Optional rigid rotation (applied before the translation).
     pub rotation: Option<Rotation>,
-}
-
-/// Rodrigues rotation of vector `v` about unit `axis` by `angle` [rad].
-pub fn rotate(v: [f64; 3], axis: [f64; 3], angle: f64) -> [f64; 3] {
-    let (s, c) = angle.sin_cos();
-    let k = axis;
-    let kxv = [
-        k[1] * v[2] - k[2] * v[1],
-        k[2] * v[0] - k[0] * v[2],
-        k[0] * v[1] - k[1] * v[0],
-    ];
-    let kdv = k[0] * v[0] + k[1] * v[1] + k[2] * v[2];
-    std::array::from_fn(|i| v[i] * c + kxv[i] * s + k[i] * kdv * (1.0 - c))
 }
 
 impl Dirichlet {

@@ -7,6 +7,7 @@
 //!   K̄ = ξ K + ξ/(θΔt) A + M/(θΔt²)
 //! The quasi-static mode drops M and A: G = F_int(u₁) − F_ext¹ − R₁, K̄ = K.
 
+mod attempt;
 mod constraints;
 mod coupling;
 mod delassus_coupling;
@@ -14,6 +15,7 @@ mod integrator;
 mod newton_coupling;
 mod newton_loop;
 
+pub use attempt::PhaseTimes;
 pub use constraints::Constraints;
 
 use crate::assembly::{BadElement, Discretisation};
@@ -22,6 +24,7 @@ use crate::contact::law::{accumulated_damage, BondState, ContactState, PointSolu
 use crate::linalg::LinalgError;
 use crate::problem::{ContactSolver, Problem};
 use crate::system::SystemMatrix;
+use attempt::Attempt;
 use coupling::{Candidates, ContactCoupling, StepContact};
 use delassus_coupling::{DelassusCache, DelassusCoupling};
 use integrator::{Inertia, Scheme, ThetaStep, Workspace};
@@ -111,20 +114,6 @@ pub struct StepReport {
     pub delassus_builds: usize,
     /// Wall time of the successful attempt, by phase [s].
     pub timings: PhaseTimes,
-}
-
-/// Wall time spent in each phase of a step [s].
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PhaseTimes {
-    /// Element loops: internal force and tangent.
-    pub assembly: f64,
-    /// Numeric factorisation of K̄ and the free solve.
-    pub factorisation: f64,
-    /// Contact detection, the Delassus operator W = H K̄⁻¹ Hᵀ (Gauss-Seidel solver) or the
-    /// analysis of the contact couplings' pattern (Newton solver).
-    pub delassus: f64,
-    /// Gauss-Seidel over contact points, or the contact law and its tangent (Newton solver).
-    pub contact_solve: f64,
 }
 
 /// The contact state of one slave node, committed at the end of every step.
@@ -271,26 +260,6 @@ pub struct Stepper {
     reactions: Vec<f64>,
     /// Buffers of the Newton loop.
     workspace: Workspace,
-}
-
-struct Attempt {
-    u: Vec<f64>,
-    v: Vec<f64>,
-    f_ext1: Vec<f64>,
-    f_int1: Vec<f64>,
-    iterations: usize,
-    residual: f64,
-    internal: f64,
-    work: f64,
-    points: Vec<ContactPoint>,
-    /// Committed bond state of each candidate at the start of the step (local frames).
-    bond0: Vec<BondState>,
-    solutions: Vec<PointSolution>,
-    sweeps: usize,
-    contact_residual: f64,
-    delassus_builds: usize,
-    timings: PhaseTimes,
-    reactions: Vec<f64>,
 }
 
 impl Stepper {

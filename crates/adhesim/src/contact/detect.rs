@@ -6,7 +6,7 @@
 use super::anisotropic::aligned_frame;
 use super::law::InterfaceLaw;
 use crate::mesh::Face;
-use crate::problem::{rotate, Rotation, Table};
+use crate::prescribed::{rotate, Rotation, Table};
 use std::collections::HashMap;
 
 /// An analytic rigid surface, in its reference position. Slave nodes must stay on the side
@@ -689,7 +689,7 @@ pub(crate) fn normalize(a: [f64; 3]) -> [f64; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::problem::Rotation;
+    use crate::prescribed::Rotation;
 
     #[test]
     fn frame_is_orthonormal_and_right_handed() {

@@ -4,8 +4,8 @@
 //! ([`super::delassus_coupling`]) and the augmented-Lagrangian Newton solve
 //! ([`super::newton_coupling`]). docs/contact-solver.md describes both.
 
+use super::attempt::PhaseTimes;
 use super::constraints::Constraints;
-use super::PhaseTimes;
 use crate::contact::detect::ContactPoint;
 use crate::contact::law::natural_map_defect;
 use crate::contact::law::{BondState, PointSolution};

@@ -3,9 +3,9 @@
 //! solved point by point and the correction completed by K̄⁻¹Hᵀ(r − r_prev). W is kept
 //! between steps and reused while it is still accurate.
 
+use super::attempt::PhaseTimes;
 use super::coupling::{ContactCoupling, Evaluated, Iterate, StepContact};
 use super::integrator::norm;
-use super::PhaseTimes;
 use crate::contact::detect::ContactPoint;
 use crate::contact::law::PointSolution;
 use crate::contact::solve::{delassus, gauss_seidel, Delassus};

@@ -3,8 +3,8 @@
 //! stiffness in K̄, a line search on the step's potential, and the multiplier update once
 //! the equilibrium with the current multipliers is reached.
 
+use super::attempt::PhaseTimes;
 use super::coupling::{ContactCoupling, Evaluated, Iterate, StepContact};
-use super::PhaseTimes;
 use crate::contact::law::{ContactState, PointSolution};
 use crate::contact::newton::{self, augmented_point, AugmentedPoint};
 use crate::system::SystemMatrix;

@@ -1,10 +1,10 @@
 //! One attempt at a step: the Newton loop over the stages of docs/model.md §3, on borrowed
 //! parts of the stepper (so that the stepper keeps only what lives between steps).
 
+use super::attempt::{Attempt, PhaseTimes};
 use super::constraints::Constraints;
 use super::coupling::{ContactCoupling, Evaluated, Iterate};
 use super::integrator::{norm, ThetaStep, Workspace};
-use super::{Attempt, PhaseTimes};
 use crate::assembly::{Assembled, Discretisation};
 use crate::problem::TimeSettings;
 use crate::system::SystemMatrix;
