@@ -12,7 +12,6 @@
 //! and last an FNV-1a 64 checksum of everything before it. The file is replaced atomically
 //! (see [`crate::output::atomic`]), so there is always one complete checkpoint: the last.
 
-use crate::output::vtk::PvdEntry;
 use crate::output::FrameProgress;
 use crate::problem::Problem;
 use crate::time::{NodeContact, Snapshot};
@@ -159,60 +158,11 @@ impl Checkpoint {
         let mut w = Enc(Vec::new());
         w.0.extend_from_slice(MAGIC);
         w.0.extend_from_slice(&FORMAT.to_le_bytes());
-        w.str(&self.version);
-        w.u64(self.fingerprint);
-        let Snapshot {
-            t,
-            step,
-            u,
-            v,
-            dt,
-            good_steps_since_cut,
-            f_ext0,
-            f_int0,
-            external_work,
-            last_internal,
-            contact,
-            material_history,
-        } = &self.snapshot;
-        w.f64(*t);
-        w.usize(*step);
-        w.f64s(u);
-        w.f64s(v);
-        w.f64(*dt);
-        w.usize(*good_steps_since_cut);
-        w.f64s(f_ext0);
-        w.f64s(f_int0);
-        w.f64(*external_work);
-        w.f64(*last_internal);
-        w.usize(contact.len());
-        for nodes in contact {
-            w.usize(nodes.len());
-            for c in nodes {
-                c.to_values().iter().for_each(|x| w.f64(*x));
-                w.0.extend_from_slice(&c.state.to_le_bytes());
-            }
-        }
-        w.f64s(material_history);
-        let FrameProgress {
-            frames,
-            next_time,
-            entries,
-        } = &self.frames;
-        w.usize(*frames);
-        w.f64(*next_time);
-        w.usize(entries.len());
-        for e in entries {
-            w.f64(e.time);
-            w.str(&e.file);
-        }
-        w.u64(self.history_rows);
-        w.usize(self.cutbacks);
-        w.usize(self.newton_iterations);
-        w.f64(self.wall_time);
+        let mut fields = self.clone();
+        fields.visit(&mut w).expect("writing to memory cannot fail");
         let mut h = Fnv::new();
         h.update(&w.0);
-        w.u64(h.0);
+        w.0.extend_from_slice(&h.0.to_le_bytes());
         w.0
     }
 
@@ -237,105 +187,144 @@ impl Checkpoint {
                 "format {format}, but this version of adhesim reads format {FORMAT}"
             ));
         }
-        let version = r.str()?;
-        let fingerprint = r.u64()?;
-        let t = r.f64()?;
-        let step = r.usize()?;
-        let u = r.f64s()?;
-        let v = r.f64s()?;
-        let dt = r.f64()?;
-        let good_steps_since_cut = r.usize()?;
-        let f_ext0 = r.f64s()?;
-        let f_int0 = r.f64s()?;
-        let external_work = r.f64()?;
-        let last_internal = r.f64()?;
-        let pairs = r.len(8)?;
-        let mut contact = Vec::with_capacity(pairs);
-        for _ in 0..pairs {
-            let n = r.len(8 * NodeContact::VALUES + 4)?;
-            let mut nodes = Vec::with_capacity(n);
-            for _ in 0..n {
-                let mut x = [0.0; NodeContact::VALUES];
-                for xi in &mut x {
-                    *xi = r.f64()?;
-                }
-                let state = i32::from_le_bytes(r.take(4)?.try_into().unwrap());
-                nodes.push(NodeContact::from_values(&x, state));
-            }
-            contact.push(nodes);
-        }
-        let material_history = r.f64s()?;
-        let frames = r.usize()?;
-        let next_time = r.f64()?;
-        let n_entries = r.len(16)?;
-        let mut entries = Vec::with_capacity(n_entries);
-        for _ in 0..n_entries {
-            let time = r.f64()?;
-            let file = r.str()?;
-            entries.push(PvdEntry { time, file });
-        }
-        let history_rows = r.u64()?;
-        let cutbacks = r.usize()?;
-        let newton_iterations = r.usize()?;
-        let wall_time = r.f64()?;
+        let mut checkpoint = Checkpoint {
+            version: String::new(),
+            fingerprint: 0,
+            snapshot: Snapshot {
+                t: 0.0,
+                step: 0,
+                u: Vec::new(),
+                v: Vec::new(),
+                dt: 0.0,
+                good_steps_since_cut: 0,
+                f_ext0: Vec::new(),
+                f_int0: Vec::new(),
+                external_work: 0.0,
+                last_internal: 0.0,
+                contact: Vec::new(),
+                material_history: Vec::new(),
+            },
+            frames: FrameProgress {
+                frames: 0,
+                next_time: 0.0,
+                entries: Vec::new(),
+            },
+            history_rows: 0,
+            cutbacks: 0,
+            newton_iterations: 0,
+            wall_time: 0.0,
+        };
+        checkpoint.visit(&mut r)?;
         if r.pos != body.len() {
             return Err(format!(
                 "{} unexpected bytes after the last field",
                 body.len() - r.pos
             ));
         }
-        Ok(Checkpoint {
-            version,
-            fingerprint,
-            snapshot: Snapshot {
-                t,
-                step,
-                u,
-                v,
-                dt,
-                good_steps_since_cut,
-                f_ext0,
-                f_int0,
-                external_work,
-                last_internal,
-                contact,
-                material_history,
-            },
-            frames: FrameProgress {
-                frames,
-                next_time,
-                entries,
-            },
-            history_rows,
-            cutbacks,
-            newton_iterations,
-            wall_time,
-        })
+        Ok(checkpoint)
+    }
+
+    /// Every field after the header, in file order, through `c`: the one list of fields that
+    /// both writing and reading follow.
+    fn visit(&mut self, c: &mut impl Codec) -> Result<(), String> {
+        c.str(&mut self.version)?;
+        c.u64(&mut self.fingerprint)?;
+        let s = &mut self.snapshot;
+        c.f64(&mut s.t)?;
+        c.usize(&mut s.step)?;
+        c.f64s(&mut s.u)?;
+        c.f64s(&mut s.v)?;
+        c.f64(&mut s.dt)?;
+        c.usize(&mut s.good_steps_since_cut)?;
+        c.f64s(&mut s.f_ext0)?;
+        c.f64s(&mut s.f_int0)?;
+        c.f64(&mut s.external_work)?;
+        c.f64(&mut s.last_internal)?;
+        c.count(&mut s.contact, 8)?;
+        for nodes in &mut s.contact {
+            c.count(nodes, 8 * NodeContact::VALUES + 4)?;
+            for node in nodes.iter_mut() {
+                let mut values = node.to_values();
+                for x in &mut values {
+                    c.f64(x)?;
+                }
+                let mut state = node.state;
+                c.i32(&mut state)?;
+                *node = NodeContact::from_values(&values, state);
+            }
+        }
+        c.f64s(&mut s.material_history)?;
+        let f = &mut self.frames;
+        c.usize(&mut f.frames)?;
+        c.f64(&mut f.next_time)?;
+        c.count(&mut f.entries, 16)?;
+        for e in &mut f.entries {
+            c.f64(&mut e.time)?;
+            c.str(&mut e.file)?;
+        }
+        c.u64(&mut self.history_rows)?;
+        c.usize(&mut self.cutbacks)?;
+        c.usize(&mut self.newton_iterations)?;
+        c.f64(&mut self.wall_time)
+    }
+}
+
+/// One direction of the checkpoint's byte format: [`Enc`] writes each value it is shown,
+/// [`Dec`] overwrites it with the next value read.
+trait Codec {
+    fn u64(&mut self, x: &mut u64) -> Result<(), String>;
+    fn i32(&mut self, x: &mut i32) -> Result<(), String>;
+    /// A count, then resizes `items` to it (reading) or writes their number (writing);
+    /// each item takes at least `item_bytes` bytes (checked against what is left).
+    fn count<T: Clone + Default>(
+        &mut self,
+        items: &mut Vec<T>,
+        item_bytes: usize,
+    ) -> Result<(), String>;
+    fn bytes(&mut self, x: &mut Vec<u8>) -> Result<(), String>;
+
+    fn usize(&mut self, x: &mut usize) -> Result<(), String> {
+        let mut v = *x as u64;
+        self.u64(&mut v)?;
+        *x = usize::try_from(v).map_err(|_| "a count does not fit in memory".to_string())?;
+        Ok(())
+    }
+    fn f64(&mut self, x: &mut f64) -> Result<(), String> {
+        let mut bits = x.to_bits();
+        self.u64(&mut bits)?;
+        *x = f64::from_bits(bits);
+        Ok(())
+    }
+    fn f64s(&mut self, x: &mut Vec<f64>) -> Result<(), String> {
+        self.count(x, 8)?;
+        x.iter_mut().try_for_each(|v| self.f64(v))
+    }
+    fn str(&mut self, s: &mut String) -> Result<(), String> {
+        let mut b = std::mem::take(s).into_bytes();
+        self.bytes(&mut b)?;
+        *s = String::from_utf8(b).map_err(|_| "a name is not UTF-8".to_string())?;
+        Ok(())
     }
 }
 
 struct Enc(Vec<u8>);
 
-impl Enc {
-    fn u64(&mut self, x: u64) {
+impl Codec for Enc {
+    fn u64(&mut self, x: &mut u64) -> Result<(), String> {
         self.0.extend_from_slice(&x.to_le_bytes());
+        Ok(())
     }
-    fn usize(&mut self, x: usize) {
-        self.u64(x as u64);
+    fn i32(&mut self, x: &mut i32) -> Result<(), String> {
+        self.0.extend_from_slice(&x.to_le_bytes());
+        Ok(())
     }
-    fn f64(&mut self, x: f64) {
-        self.u64(x.to_bits());
+    fn count<T: Clone + Default>(&mut self, items: &mut Vec<T>, _: usize) -> Result<(), String> {
+        self.u64(&mut (items.len() as u64))
     }
-    fn f64s(&mut self, x: &[f64]) {
-        self.usize(x.len());
-        self.0.reserve(8 * x.len());
-        for v in x {
-            self.f64(*v);
-        }
-    }
-    fn str(&mut self, s: &str) {
-        self.usize(s.len());
-        self.0.extend_from_slice(s.as_bytes());
+    fn bytes(&mut self, x: &mut Vec<u8>) -> Result<(), String> {
+        self.u64(&mut (x.len() as u64))?;
+        self.0.extend_from_slice(x);
+        Ok(())
     }
 }
 
@@ -353,36 +342,47 @@ impl Dec<'_> {
         self.pos += n;
         Ok(s)
     }
-    fn u64(&mut self) -> Result<u64, String> {
-        Ok(u64::from_le_bytes(self.take(8)?.try_into().unwrap()))
-    }
-    fn usize(&mut self) -> Result<usize, String> {
-        usize::try_from(self.u64()?).map_err(|_| "a count does not fit in memory".to_string())
-    }
     /// A count of items of at least `item_bytes` bytes each, checked against what is left.
     fn len(&mut self, item_bytes: usize) -> Result<usize, String> {
-        let n = self.usize()?;
+        let mut n = 0;
+        self.usize(&mut n)?;
         if n.saturating_mul(item_bytes) > self.bytes.len() - self.pos {
             return Err(format!("a count ({n}) exceeds the file's size"));
         }
         Ok(n)
     }
-    fn f64(&mut self) -> Result<f64, String> {
-        Ok(f64::from_bits(self.u64()?))
+}
+
+impl Codec for Dec<'_> {
+    fn u64(&mut self, x: &mut u64) -> Result<(), String> {
+        *x = u64::from_le_bytes(self.take(8)?.try_into().unwrap());
+        Ok(())
     }
-    fn f64s(&mut self) -> Result<Vec<f64>, String> {
-        let n = self.len(8)?;
-        (0..n).map(|_| self.f64()).collect()
+    fn i32(&mut self, x: &mut i32) -> Result<(), String> {
+        *x = i32::from_le_bytes(self.take(4)?.try_into().unwrap());
+        Ok(())
     }
-    fn str(&mut self) -> Result<String, String> {
+    fn count<T: Clone + Default>(
+        &mut self,
+        items: &mut Vec<T>,
+        item_bytes: usize,
+    ) -> Result<(), String> {
+        let n = self.len(item_bytes)?;
+        items.clear();
+        items.resize(n, T::default());
+        Ok(())
+    }
+    fn bytes(&mut self, x: &mut Vec<u8>) -> Result<(), String> {
         let n = self.len(1)?;
-        String::from_utf8(self.take(n)?.to_vec()).map_err(|_| "a name is not UTF-8".to_string())
+        *x = self.take(n)?.to_vec();
+        Ok(())
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::output::vtk::PvdEntry;
 
     fn sample() -> Checkpoint {
         let c = NodeContact {

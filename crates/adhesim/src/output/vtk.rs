@@ -507,7 +507,7 @@ fn push_escaped(out: &mut String, s: &str) {
 }
 
 /// One data set of a ParaView collection.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct PvdEntry {
     /// Simulation time.
     pub time: f64,
