@@ -3,9 +3,9 @@
 //! solved point by point and the correction completed by K̄⁻¹Hᵀ(r − r_prev). W is kept
 //! between steps and reused while it is still accurate.
 
-use super::attempt::PhaseTimes;
 use super::coupling::{ContactCoupling, Evaluated, Iterate, StepContact};
 use super::integrator::norm;
+use super::PhaseTimes;
 use crate::contact::detect::ContactPoint;
 use crate::contact::law::PointSolution;
 use crate::contact::solve::{delassus, gauss_seidel, Delassus};
@@ -222,17 +222,21 @@ impl<'a> ContactCoupling<'a> for DelassusCoupling<'a> {
     }
 }
 
-/// Which W a step can start from: Δt (K̄ = ξK + M/(θΔt²) + ...) and the contact points'
-/// nodes (pair, slave and master nodes), compared bit for bit. The frames and master weights
-/// drift from step to step as the surfaces move; a W built for slightly different ones is
-/// kept as long as the probe of [`DelassusCoupling::operator`] finds its columns accurate.
+/// What W depends on besides K̄: the contact points (pair, node, frame, master weights) and
+/// Δt (K̄ = ξK + M/(θΔt²) + ...). Compared bit for bit.
 fn delassus_key(points: &[ContactPoint], dt: f64) -> Vec<u64> {
-    let mut key = Vec::with_capacity(points.len() * 6 + 1);
+    let mut key = Vec::with_capacity(points.len() * 12 + 1);
     key.push(dt.to_bits());
     for p in points {
         key.push(p.pair as u64);
         key.extend(p.slave_nodes().map(|(s, _)| s as u64));
-        key.extend(p.master.iter().map(|&(m, _)| m as u64));
+        for row in &p.frame {
+            key.extend(row.iter().map(|x| x.to_bits()));
+        }
+        for &(m, w) in &p.master {
+            key.push(m as u64);
+            key.push(w.to_bits());
+        }
     }
     key
 }
