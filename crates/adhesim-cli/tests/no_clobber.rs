@@ -7,7 +7,9 @@
 use adhesim::output::csv::read_history;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
-use std::time::{Duration, Instant};
+
+mod common;
+use common::*;
 
 const BIN: &str = env!("CARGO_BIN_EXE_adhesim");
 
@@ -43,28 +45,6 @@ fn spawn(out: &Path) -> Child {
 
 fn run(out: &Path, extra: &[&str]) -> Output {
     command(out, extra).output().unwrap()
-}
-
-/// Waits until history.csv holds `rows` complete rows; panics if the run ends first.
-fn wait_for_rows(child: &mut Child, out: &Path, rows: usize) {
-    let start = Instant::now();
-    loop {
-        let text = std::fs::read_to_string(out.join("history.csv")).unwrap_or_default();
-        if text.matches('\n').count() > rows {
-            return;
-        }
-        if let Some(status) = child.try_wait().unwrap() {
-            panic!("the run ended ({status}) before writing {rows} rows");
-        }
-        assert!(start.elapsed() < Duration::from_secs(60), "no progress");
-        std::thread::sleep(Duration::from_millis(2));
-    }
-}
-
-fn status_in_run_json(out: &Path) -> String {
-    let json: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("run.json")).unwrap()).unwrap();
-    json["outcome"]["status"].as_str().unwrap().to_string()
 }
 
 /// Every line of history.csv has the header's number of fields and the steps run 0, 1, 2, …

@@ -12,6 +12,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
+mod common;
+use common::*;
+
 const BIN: &str = env!("CARGO_BIN_EXE_adhesim");
 
 /// Why Slurm cannot be used here, if it cannot.
@@ -69,20 +72,6 @@ fn sweep(out: &Path, extra: &[&str]) -> Command {
         .arg(out)
         .args(extra);
     c
-}
-
-/// sweep.csv without its wall_time column.
-fn table_without_wall_time(dir: &Path) -> Vec<Vec<String>> {
-    let text = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
-    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    let k = header.iter().position(|h| *h == "wall_time").unwrap();
-    text.lines()
-        .map(|l| {
-            let mut f: Vec<String> = l.split(',').map(String::from).collect();
-            f.remove(k);
-            f
-        })
-        .collect()
 }
 
 /// The physical kind of a summary column (`<owner>.<field>.<stat>`), so that numbers are

@@ -9,6 +9,9 @@ use std::process::{Child, Command, Stdio};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
+mod common;
+use common::*;
+
 const BIN: &str = env!("CARGO_BIN_EXE_adhesim");
 
 fn work_dir() -> PathBuf {
@@ -43,20 +46,6 @@ fn reference() -> &'static Path {
         assert!(output.status.success(), "reference sweep: {output:?}");
         out
     })
-}
-
-/// sweep.csv without its wall_time column.
-fn table_without_wall_time(dir: &Path) -> Vec<Vec<String>> {
-    let text = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
-    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    let k = header.iter().position(|h| *h == "wall_time").unwrap();
-    text.lines()
-        .map(|l| {
-            let mut f: Vec<String> = l.split(',').map(String::from).collect();
-            f.remove(k);
-            f
-        })
-        .collect()
 }
 
 fn status(dir: &Path) -> Option<String> {
