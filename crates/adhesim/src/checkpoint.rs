@@ -112,7 +112,7 @@ impl Checkpoint {
     }
 
     /// Writes the checkpoint to `DIR/checkpoint.bin`, replacing the previous one atomically.
-    pub fn write(&self, dir: &Path) -> Result<(), CheckpointError> {
+    pub fn write(self, dir: &Path) -> Result<(), CheckpointError> {
         let path = Self::path(dir);
         crate::output::atomic::write_atomic(&path, &self.encode())
             .map_err(|source| CheckpointError::Io { path, source })
@@ -153,13 +153,14 @@ impl Checkpoint {
         Ok(())
     }
 
-    /// The checkpoint as bytes (see the module documentation for the layout).
-    pub fn encode(&self) -> Vec<u8> {
+    /// The checkpoint as bytes (see the module documentation for the layout). It takes the
+    /// checkpoint by value: [`Checkpoint::visit`], which reading shares, needs its fields
+    /// mutable, and the caller has no further use for them.
+    pub fn encode(mut self) -> Vec<u8> {
         let mut w = Enc(Vec::new());
         w.0.extend_from_slice(MAGIC);
         w.0.extend_from_slice(&FORMAT.to_le_bytes());
-        let mut fields = self.clone();
-        fields.visit(&mut w).expect("writing to memory cannot fail");
+        self.visit(&mut w).expect("writing to memory cannot fail");
         let mut h = Fnv::new();
         h.update(&w.0);
         w.0.extend_from_slice(&h.0.to_le_bytes());
@@ -431,13 +432,13 @@ mod tests {
 
     fn bits_equal(a: &Checkpoint, b: &Checkpoint) -> bool {
         // NaN != NaN, so compare the encodings.
-        a.encode() == b.encode()
+        a.clone().encode() == b.clone().encode()
     }
 
     #[test]
     fn round_trip_is_bit_exact() {
         let c = sample();
-        let bytes = c.encode();
+        let bytes = c.clone().encode();
         let d = Checkpoint::decode(&bytes).unwrap();
         assert!(bits_equal(&c, &d));
         assert!(d.snapshot.contact[0][0].gap.is_nan());
