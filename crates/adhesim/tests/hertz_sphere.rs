@@ -191,6 +191,22 @@ struct Indentation {
     seconds: f64,
 }
 
+/// Prints each run's force against Hertz's `f_hertz` [N], its contact radius in units of `a`
+/// [m], its Newton iterations and its time, labelled `case` and the run's name.
+fn report(case: &str, runs: &[(&str, &Indentation)], f_hertz: f64, a: f64) {
+    for (name, r) in runs {
+        eprintln!(
+            "{case}, {name}: F = {:.5e} N ({:+.2} % off Hertz), contact radius {:.3} a, \
+             {} Newton iterations in one step, {:.1} s",
+            r.force,
+            100.0 * (r.force / f_hertz - 1.0),
+            r.radius / a,
+            r.newton,
+            r.seconds
+        );
+    }
+}
+
 /// Presses the sphere by D into the Blatz-Ko quarter half-space meshed with k cells across
 /// the core cube of half-size 1.5 a (h = 1.5 a / k). Surface nodes within `detection` of the
 /// sphere are contact candidates.
@@ -467,17 +483,12 @@ fn hertz_on_a_nearly_incompressible_half_space() {
         ContactSolver::GaussSeidel,
     );
     let a = (R * D).sqrt();
-    for (name, r) in [("F-bar", &fbar), ("full integration", &full)] {
-        eprintln!(
-            "ν = {nu}, {name}: F = {:.5e} N ({:+.2} % off Hertz), contact radius {:.3} a, \
-             {} Newton iterations in one step, {:.1} s",
-            r.force,
-            100.0 * (r.force / f_hertz - 1.0),
-            r.radius / a,
-            r.newton,
-            r.seconds
-        );
-    }
+    report(
+        &format!("ν = {nu}"),
+        &[("F-bar", &fbar), ("full integration", &full)],
+        f_hertz,
+        a,
+    );
     let err = fbar.force / f_hertz - 1.0;
     assert!(err.abs() < 0.03, "F-bar: force error {:+.2} %", 100.0 * err);
     assert!(
@@ -534,17 +545,12 @@ fn hertz_on_a_nearly_incompressible_half_space_of_tetrahedra() {
     };
     let anp = run(Formulation::AveragedNodalPressure);
     let linear = run(Formulation::Standard);
-    for (name, r) in [("averaged nodal pressure", &anp), ("linear tet4", &linear)] {
-        eprintln!(
-            "tetrahedra, ν = {nu}, {name}: F = {:.5e} N ({:+.2} % off Hertz), contact radius \
-             {:.3} a, {} Newton iterations in one step, {:.1} s",
-            r.force,
-            100.0 * (r.force / f_hertz - 1.0),
-            r.radius / a,
-            r.newton,
-            r.seconds
-        );
-    }
+    report(
+        &format!("tetrahedra, ν = {nu}"),
+        &[("averaged nodal pressure", &anp), ("linear tet4", &linear)],
+        f_hertz,
+        a,
+    );
     let err = anp.force / f_hertz - 1.0;
     assert!(err.abs() < 0.03, "anp: force error {:+.2} %", 100.0 * err);
     assert!(anp.min_gap > -1e-6 * D, "penetration {:e} m", -anp.min_gap);
