@@ -47,14 +47,18 @@ pub enum SetupError {
 /// Checks the reference meshes of `problem` for degenerate or inverted elements (what
 /// [`Stepper::new`] would refuse), without building the system matrix.
 pub fn check_elements(problem: &Problem) -> Result<(), SetupError> {
+    discretise(problem).map(|_| ())
+}
+
+/// The elements of every body of `problem`, each body with its element formulation.
+fn discretise(problem: &Problem) -> Result<Discretisation, SetupError> {
     let bodies: Vec<_> = problem
         .bodies
         .iter()
         .map(|b| (&b.mesh, b.material.clone()))
         .collect();
-    Discretisation::new(&bodies)
-        .map(|_| ())
-        .map_err(SetupError::BadElements)
+    let formulations: Vec<_> = problem.bodies.iter().map(|b| b.element).collect();
+    Discretisation::with_formulations(&bodies, &formulations).map_err(SetupError::BadElements)
 }
 
 fn describe_bad(bad: &[BadElement]) -> String {
@@ -265,14 +269,7 @@ pub struct Stepper {
 impl Stepper {
     /// Discretises the problem and analyses the system matrix.
     pub fn new(problem: Arc<Problem>) -> Result<Self, SetupError> {
-        let bodies: Vec<_> = problem
-            .bodies
-            .iter()
-            .map(|b| (&b.mesh, b.material.clone()))
-            .collect();
-        let formulations: Vec<_> = problem.bodies.iter().map(|b| b.element).collect();
-        let disc = Discretisation::with_formulations(&bodies, &formulations)
-            .map_err(SetupError::BadElements)?;
+        let disc = discretise(&problem)?;
         let density: Vec<f64> = problem.bodies.iter().map(|b| b.density).collect();
         let mass = disc.mass(&density, problem.time.lumped_mass);
         let n = disc.num_dofs();

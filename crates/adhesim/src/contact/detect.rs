@@ -198,7 +198,7 @@ impl ContactPoint {
     /// The slave nodes with their weights in the point's slave displacement: the node alone
     /// (weight 1), or the node and its twins through a plane-strain slab (equal weights).
     pub fn slave_nodes(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
-        let w = 1.0 / (1 + self.twins.len()) as f64;
+        let w = self.node_share();
         std::iter::once(self.slave)
             .chain(self.twins.iter().map(|t| t.0))
             .map(move |s| (s, w))
