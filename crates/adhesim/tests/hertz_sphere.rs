@@ -453,6 +453,18 @@ fn hertz_with_two_thousand_contact_candidates() {
     assert!(r.min_gap > -1e-6 * D, "penetration {:e} m", -r.min_gap);
 }
 
+/// An uncoupled neo-Hookean half-space with the shear modulus G of this file and Poisson ratio
+/// `nu`, and its Hertz force 4/3 E* √R d^(3/2) [N], E* = E/(1 − ν²).
+fn nearly_incompressible(nu: f64) -> (Arc<dyn Hyperelastic>, f64) {
+    let young = 2.0 * G * (1.0 + nu);
+    let e_star = young / (1.0 - nu * nu);
+    let f_hertz = 4.0 / 3.0 * e_star * R.sqrt() * D.powf(1.5);
+    (
+        Arc::new(UncoupledNeoHookean::from_young_poisson(young, nu)),
+        f_hertz,
+    )
+}
+
 /// Hertz on a nearly incompressible half-space (uncoupled neo-Hookean, ν = 0.4999, F-bar
 /// hexahedra): F = 4/3 E* √R d^(3/2) with E* = E/(1 − ν²) ≈ 4μ. One mesh, h = a/4, within
 /// 1 % in the Blatz-Ko study above, whose error budget (≈ +0.4 % of model differences, ≈ 1 % of
@@ -462,12 +474,8 @@ fn hertz_with_two_thousand_contact_candidates() {
 #[test]
 fn hertz_on_a_nearly_incompressible_half_space() {
     let nu = 0.4999;
-    let young = 2.0 * G * (1.0 + nu);
-    let e_star = young / (1.0 - nu * nu);
-    let f_hertz = 4.0 / 3.0 * e_star * R.sqrt() * D.powf(1.5);
-    let material = || -> Arc<dyn Hyperelastic> {
-        Arc::new(UncoupledNeoHookean::from_young_poisson(young, nu))
-    };
+    let (material, f_hertz) = nearly_incompressible(nu);
+    let material = || material.clone();
     let fbar = indent_with(
         4,
         material(),
@@ -518,12 +526,8 @@ fn hertz_on_a_nearly_incompressible_half_space() {
 #[test]
 fn hertz_on_a_nearly_incompressible_half_space_of_tetrahedra() {
     let nu = 0.4999;
-    let young = 2.0 * G * (1.0 + nu);
-    let e_star = young / (1.0 - nu * nu);
-    let f_hertz = 4.0 / 3.0 * e_star * R.sqrt() * D.powf(1.5);
-    let material = || -> Arc<dyn Hyperelastic> {
-        Arc::new(UncoupledNeoHookean::from_young_poisson(young, nu))
-    };
+    let (material, f_hertz) = nearly_incompressible(nu);
+    let material = || material.clone();
     let a = (R * D).sqrt();
     let (c, k) = (1.5 * a, 6);
     let hexes = graded_octant(c, k, 1.0 + 1.0 / k as f64, EXTENT * a);
