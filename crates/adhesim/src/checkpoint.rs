@@ -2,8 +2,8 @@
 //!
 //! A checkpoint holds the stepper's [`Snapshot`] (time, step counter, u, v, the committed
 //! contact state, the internal variables of viscoelastic materials, the current Δt and its
-//! cut-back bookkeeping, the energy accumulators and the forces at the start of the next
-//! step), how far the outputs got (frames written, the next frame time, the PVD entries,
+//! cut-back bookkeeping, the energy accumulators, the forces at the start of the next
+//! step and the Delassus operator the Gauss-Seidel contact solve keeps for reuse), how far the outputs got (frames written, the next frame time, the PVD entries,
 //! history rows) and the run's counters. It is tied to the problem it was written for by a
 //! fingerprint, so that resuming with a changed scenario is refused.
 //!
@@ -12,9 +12,10 @@
 //! and last an FNV-1a 64 checksum of everything before it. The file is replaced atomically
 //! (see [`crate::output::atomic`]), so there is always one complete checkpoint: the last.
 
+use crate::contact::solve::Delassus;
 use crate::output::FrameProgress;
 use crate::problem::Problem;
-use crate::time::{NodeContact, Snapshot};
+use crate::time::{CachedDelassus, DelassusCache, NodeContact, Snapshot};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -22,7 +23,7 @@ use std::path::{Path, PathBuf};
 pub const FILE_NAME: &str = "checkpoint.bin";
 
 const MAGIC: &[u8; 8] = b"ADHCKPT\0";
-const FORMAT: u32 = 3;
+const FORMAT: u32 = 4;
 
 /// A run's state after a committed step.
 #[derive(Clone, Debug, PartialEq)]
@@ -204,6 +205,7 @@ impl Checkpoint {
                 last_internal: 0.0,
                 contact: Vec::new(),
                 material_history: Vec::new(),
+                delassus: None,
             },
             frames: FrameProgress {
                 frames: 0,
@@ -255,6 +257,7 @@ impl Checkpoint {
             }
         }
         c.f64s(&mut s.material_history)?;
+        delassus(c, &mut s.delassus)?;
         let f = &mut self.frames;
         c.usize(&mut f.frames)?;
         c.f64(&mut f.next_time)?;
@@ -268,6 +271,39 @@ impl Checkpoint {
         c.usize(&mut self.newton_iterations)?;
         c.f64(&mut self.wall_time)
     }
+}
+
+/// The kept Delassus operator: a count (0 or 1), then its key, its frames and W.
+fn delassus(c: &mut impl Codec, cache: &mut DelassusCache) -> Result<(), String> {
+    let mut present: Vec<()> = cache.iter().map(|_| ()).collect();
+    c.count(&mut present, 24)?;
+    if present.len() > 1 {
+        return Err("more than one Delassus operator".into());
+    }
+    if present.is_empty() {
+        *cache = None;
+        return Ok(());
+    }
+    let d = cache.get_or_insert_with(|| CachedDelassus {
+        key: Vec::new(),
+        frames: Vec::new(),
+        w: Delassus {
+            w: Vec::new(),
+            m: 0,
+        },
+    });
+    c.count(&mut d.key, 8)?;
+    d.key.iter_mut().try_for_each(|k| c.u64(k))?;
+    c.count(&mut d.frames, 72)?;
+    for x in d.frames.iter_mut().flatten().flatten() {
+        c.f64(x)?;
+    }
+    c.usize(&mut d.w.m)?;
+    c.f64s(&mut d.w.w)?;
+    if d.w.w.len() != d.w.m * d.w.m || d.w.m != 3 * d.frames.len() {
+        return Err("the Delassus operator's sizes do not agree".into());
+    }
+    Ok(())
 }
 
 /// One direction of the checkpoint's byte format: [`Enc`] writes each value it is shown,
@@ -414,6 +450,14 @@ mod tests {
                 last_internal: 1.0,
                 contact: vec![vec![c, NodeContact::default()], vec![]],
                 material_history: vec![0.25, -1e-9],
+                delassus: Some(CachedDelassus {
+                    key: vec![7, u64::MAX],
+                    frames: vec![[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -0.5]]],
+                    w: Delassus {
+                        w: (0..9).map(|i| i as f64 * 1e-7).collect(),
+                        m: 3,
+                    },
+                }),
             },
             frames: FrameProgress {
                 frames: 3,

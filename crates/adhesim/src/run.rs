@@ -335,9 +335,6 @@ pub fn run_with(
                     let every = control.checkpoint_every;
                     if every > 0 && stepper.state.step % every == 0 && !stepper.finished() {
                         save(&mut summary, &stepper, &frames, &history)?;
-                        // A resumed run starts without a Delassus operator to reuse; so does
-                        // this one, so that both take the same Newton iterates.
-                        stepper.forget_delassus();
                     }
                 }
                 Err(e) => {

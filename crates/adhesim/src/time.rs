@@ -26,7 +26,8 @@ use crate::problem::{ContactSolver, Problem};
 use crate::system::SystemMatrix;
 use attempt::Attempt;
 use coupling::{Candidates, ContactCoupling, StepContact};
-use delassus_coupling::{DelassusCache, DelassusCoupling};
+use delassus_coupling::DelassusCoupling;
+pub use delassus_coupling::{CachedDelassus, DelassusCache};
 use integrator::{Inertia, Scheme, ThetaStep, Workspace};
 use newton_coupling::NewtonCoupling;
 use newton_loop::{Flow, NewtonLoop};
@@ -233,6 +234,9 @@ pub struct Snapshot {
     /// Internal variables of the viscoelastic materials (see
     /// [`Discretisation::history`]).
     pub material_history: Vec<f64>,
+    /// The Delassus operator the Gauss-Seidel contact solve keeps for reuse: the next step's
+    /// iterates depend on it.
+    pub delassus: DelassusCache,
 }
 
 /// Advances a [`Problem`] in time.
@@ -378,6 +382,7 @@ impl Stepper {
             last_internal: self.last_internal,
             contact: self.contact.clone(),
             material_history: self.disc.history(),
+            delassus: self.delassus_cache.clone(),
         }
     }
 
@@ -421,6 +426,7 @@ impl Stepper {
         self.external_work = snap.external_work;
         self.last_internal = snap.last_internal;
         self.contact = snap.contact;
+        self.delassus_cache = snap.delassus;
         Ok(())
     }
 
@@ -600,11 +606,6 @@ impl Stepper {
             self.state.t = self.problem.time.t_end;
         }
         self.state.step += 1;
-    }
-
-    /// Drops the Delassus operator kept for reuse (the next contact solve builds its own).
-    pub fn forget_delassus(&mut self) {
-        self.delassus_cache = None;
     }
 
     /// Committed dry force of each contact point, in its local frame: the warm start of the

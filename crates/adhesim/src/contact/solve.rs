@@ -2,11 +2,12 @@
 //! W = H K̄⁻¹ Hᵀ from one multi-right-hand-side solve with the iteration's factorisation, and
 //! a nonlinear Gauss-Seidel sweep over contact points with the local bi-potential/RCC solve.
 
-use super::detect::ContactPoint;
+use super::detect::{dot, ContactPoint};
 use super::law::{default_rho, solve_point, BondState, InterfaceLaw, PointProblem, PointSolution};
 use crate::linalg::SparseCholesky;
 
 /// The dense Delassus operator W = H K̄⁻¹ Hᵀ of the contact points.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Delassus {
     /// W, 3N_c × 3N_c, row-major [m/N].
     pub w: Vec<f64>,
@@ -94,6 +95,43 @@ pub fn delassus(
 }
 
 impl Delassus {
+    /// Turns W, built in the local frames `from` of its points (rows T₁, T₂, N), to the
+    /// frames `to`: block αβ becomes R_α W_αβ R_βᵀ with R_α = F_to,α F_from,αᵀ. Exact when
+    /// the points' nodes, master weights and K̄ are the same, since W_αβ = F_α W^g_αβ F_βᵀ
+    /// with W^g in global axes.
+    pub fn rotate_frames(&mut self, from: &[[[f64; 3]; 3]], to: &[[[f64; 3]; 3]]) {
+        assert_eq!(from.len(), to.len());
+        assert_eq!(3 * from.len(), self.m);
+        // None where a point's frame is unchanged: its blocks stay bit for bit.
+        let rot: Vec<Option<[[f64; 3]; 3]>> = from
+            .iter()
+            .zip(to)
+            .map(|(f, t)| {
+                (f != t).then(|| std::array::from_fn(|i| std::array::from_fn(|j| dot(t[i], f[j]))))
+            })
+            .collect();
+        const IDENTITY: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let m = self.m;
+        for (a, ra) in rot.iter().enumerate() {
+            for (b, rb) in rot.iter().enumerate() {
+                if ra.is_none() && rb.is_none() {
+                    continue;
+                }
+                let (ra, rb) = (ra.unwrap_or(IDENTITY), rb.unwrap_or(IDENTITY));
+                let at = |k: usize, l: usize| self.w[(3 * a + k) * m + 3 * b + l];
+                // R_α W_αβ, then times R_βᵀ.
+                let left: [[f64; 3]; 3] = std::array::from_fn(|i| {
+                    std::array::from_fn(|l| (0..3).map(|k| ra[i][k] * at(k, l)).sum())
+                });
+                for (i, row) in left.iter().enumerate() {
+                    for (j, rbj) in rb.iter().enumerate() {
+                        self.w[(3 * a + i) * m + 3 * b + j] = dot(*row, *rbj);
+                    }
+                }
+            }
+        }
+    }
+
     /// Relative change ‖W_now − W‖ / ‖W_now‖ over the three columns of contact point `probe`,
     /// with W_now from the current factorisation: three solves instead of the 3N_c of a
     /// rebuild, to tell whether this W can still be used.
@@ -223,5 +261,76 @@ pub fn gauss_seidel(
             .collect(),
         sweeps,
         converged,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::detect::frame_from_normal as unit_frame;
+
+    fn frame_from_normal(n: [f64; 3]) -> [[f64; 3]; 3] {
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        unit_frame(n.map(|c| c / len))
+    }
+
+    /// W in local frames from W^g in global axes: W_αβ = F_α W^g_αβ F_βᵀ.
+    fn local(wg: &[f64], frames: &[[[f64; 3]; 3]]) -> Delassus {
+        let m = 3 * frames.len();
+        let mut w = vec![0.0; m * m];
+        for (a, fa) in frames.iter().enumerate() {
+            for (b, fb) in frames.iter().enumerate() {
+                for i in 0..3 {
+                    for j in 0..3 {
+                        w[(3 * a + i) * m + 3 * b + j] = (0..3)
+                            .flat_map(|k| (0..3).map(move |l| (k, l)))
+                            .map(|(k, l)| fa[i][k] * wg[(3 * a + k) * m + 3 * b + l] * fb[j][l])
+                            .sum();
+                    }
+                }
+            }
+        }
+        Delassus { w, m }
+    }
+
+    /// Turning W from one set of frames to another gives W built in the new frames, to
+    /// round-off (1e-15 of its largest entry: a handful of products of unit rotations).
+    #[test]
+    fn turning_w_to_new_frames_equals_building_it_there() {
+        let m = 9;
+        // A symmetric positive definite W^g: AᵀA + I with a fixed, uneven A.
+        let a: Vec<f64> = (0..m * m)
+            .map(|k| ((k * 37 % 11) as f64 - 5.0) * 0.1)
+            .collect();
+        let wg: Vec<f64> = (0..m * m)
+            .map(|k| {
+                let (i, j) = (k / m, k % m);
+                (0..m).map(|r| a[r * m + i] * a[r * m + j]).sum::<f64>()
+                    + if i == j { 1.0 } else { 0.0 }
+            })
+            .collect();
+        let old = [
+            frame_from_normal([0.0, 1.0, 0.0]),
+            frame_from_normal([0.3, 0.9, 0.1]),
+            frame_from_normal([-0.5, 0.5, 0.7]),
+        ];
+        let new = [
+            frame_from_normal([0.1, 1.0, 0.0]),
+            frame_from_normal([0.3, 0.9, 0.1]),
+            frame_from_normal([0.0, 0.2, 1.0]),
+        ];
+        let mut w = local(&wg, &old);
+        w.rotate_frames(&old, &new);
+        let expected = local(&wg, &new);
+        let scale = expected.w.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+        let err =
+            w.w.iter()
+                .zip(&expected.w)
+                .fold(0.0f64, |s, (x, y)| s.max((x - y).abs()));
+        assert!(err <= 1e-15 * scale * 10.0, "error {err:e} of {scale:e}");
+        // Unchanged frames leave W bit for bit as it was.
+        let before = w.clone();
+        w.rotate_frames(&new, &new);
+        assert_eq!(w, before);
     }
 }

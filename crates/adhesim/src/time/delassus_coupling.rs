@@ -25,9 +25,20 @@ const SWEEP_TOL: f64 = 1e-10;
 /// Sweeps after which the contact solve gives up (the step is then cut back).
 const MAX_SWEEPS: usize = 5000;
 
-/// The last Delassus operator and what it was built for (see [`delassus_key`]); kept
-/// between steps.
-pub type DelassusCache = Option<(Vec<u64>, Delassus)>;
+/// The last Delassus operator, kept between steps (and in checkpoints, so that a resumed
+/// run reuses it exactly as the uninterrupted run would).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CachedDelassus {
+    /// What it was built for besides the frames and K̄ (see [`delassus_key`]).
+    pub key: Vec<u64>,
+    /// The local frame of each point (rows T₁, T₂, N) W is expressed in.
+    pub frames: Vec<[[f64; 3]; 3]>,
+    /// W in those frames.
+    pub w: Delassus,
+}
+
+/// The Delassus operator kept for reuse, if any.
+pub type DelassusCache = Option<CachedDelassus>;
 
 /// The Gauss-Seidel contact solve of one step.
 pub struct DelassusCoupling<'a> {
@@ -78,7 +89,17 @@ impl<'a> DelassusCoupling<'a> {
             .prev_du_norm
             .is_some_and(|p| du_norm > DELASSUS_REUSE_RATIO * p);
         self.prev_du_norm = Some(du_norm);
-        let mut reusable = matches!(&*self.cache, Some((k, _)) if *k == self.key);
+        let mut reusable = matches!(&*self.cache, Some(c) if c.key == self.key);
+        if reusable {
+            // Same points: turn W to this step's frames (exact while K̄ and the master
+            // weights are unchanged); the probe below judges what else changed.
+            let cached = self.cache.as_mut().expect("matched above");
+            let frames: Vec<_> = self.sc.points.iter().map(|p| p.frame).collect();
+            if cached.frames != frames {
+                cached.w.rotate_frames(&cached.frames, &frames);
+                cached.frames = frames;
+            }
+        }
         // Slow convergence comes from the nonsmooth contact laws as often as from a stale W:
         // probe the columns of the point carrying the largest force (the first point while
         // r_contact is still zero) and rebuild only when they differ from the cached ones.
@@ -91,7 +112,7 @@ impl<'a> DelassusCoupling<'a> {
                 .max_by(|a, b| norm(a.1).total_cmp(&norm(b.1)))
                 .map(|(p, _)| p)
                 .unwrap_or(0);
-            let cached = &self.cache.as_ref().expect("checked").1;
+            let cached = &self.cache.as_ref().expect("checked").w;
             let mask = self.sc.constraints.mask();
             reusable = cached.probed_change(&self.sc.points, probe, system.cholesky(), mask)
                 <= DELASSUS_STALE_TOL;
@@ -99,7 +120,11 @@ impl<'a> DelassusCoupling<'a> {
         if !reusable {
             let mask = self.sc.constraints.mask();
             let del = delassus(&self.sc.points, system.cholesky(), mask);
-            *self.cache = Some((self.key.clone(), del));
+            *self.cache = Some(CachedDelassus {
+                key: self.key.clone(),
+                frames: self.sc.points.iter().map(|p| p.frame).collect(),
+                w: del,
+            });
             self.builds += 1;
             self.checked = true;
         }
@@ -140,7 +165,7 @@ impl<'a> ContactCoupling<'a> for DelassusCoupling<'a> {
         }
         let clock = Instant::now();
         self.operator(du, system);
-        let del = &self.cache.as_ref().expect("built above").1;
+        let del = &self.cache.as_ref().expect("built above").w;
         let m = del.m;
         // Reduced contact system: x = x(u) + H Δu_free + W (r − r_prev).
         let x_free: Vec<[f64; 3]> = self
@@ -222,21 +247,19 @@ impl<'a> ContactCoupling<'a> for DelassusCoupling<'a> {
     }
 }
 
-/// What W depends on besides K̄: the contact points (pair, node, frame, master weights) and
-/// Δt (K̄ = ξK + M/(θΔt²) + ...). Compared bit for bit.
+/// What a cached W must share with this step to be reused: the contact points (pair, slave
+/// nodes, master nodes) and Δt (K̄ = ξK + M/(θΔt²) + ...), compared bit for bit. The frames
+/// are turned exactly ([`Delassus::rotate_frames`]); changes of K̄ and of the master weights
+/// are left to the probe.
 fn delassus_key(points: &[ContactPoint], dt: f64) -> Vec<u64> {
-    let mut key = Vec::with_capacity(points.len() * 12 + 1);
+    let mut key = Vec::with_capacity(points.len() * 6 + 1);
     key.push(dt.to_bits());
     for p in points {
         key.push(p.pair as u64);
+        key.push(p.slave_nodes().count() as u64);
         key.extend(p.slave_nodes().map(|(s, _)| s as u64));
-        for row in &p.frame {
-            key.extend(row.iter().map(|x| x.to_bits()));
-        }
-        for &(m, w) in &p.master {
-            key.push(m as u64);
-            key.push(w.to_bits());
-        }
+        key.push(p.master.len() as u64);
+        key.extend(p.master.iter().map(|&(m, _)| m as u64));
     }
     key
 }
