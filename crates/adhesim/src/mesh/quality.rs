@@ -4,6 +4,7 @@
 //! `hexes.len() + j` is `tets[j]`.
 
 use super::{Face, Mesh, HEX_FACES, TET_FACES};
+use crate::{Mat3, Vec3};
 use std::collections::HashMap;
 
 /// For each hex corner (VTK order): the corner and its neighbours along ξ, η, ζ, ordered so
@@ -79,17 +80,17 @@ pub fn check_faces_outward(mesh: &Mesh) -> Result<(), String> {
 
 /// Scaled Jacobian of the frame of unit edge vectors from node `corner` to `ends`.
 fn corner_ratio(nodes: &[[f64; 3]], corner: usize, ends: [usize; 3]) -> f64 {
-    let o = nodes[corner];
-    let mut e = [[0.0; 3]; 3];
+    let o = Vec3::from(nodes[corner]);
+    let mut e = [Vec3::zeros(); 3];
     for (k, &end) in ends.iter().enumerate() {
-        let d = sub(nodes[end], o);
-        let len = norm(d);
+        let d = Vec3::from(nodes[end]) - o;
+        let len = d.norm();
         if len == 0.0 || !len.is_finite() {
             return 0.0;
         }
-        e[k] = d.map(|x| x / len);
+        e[k] = d / len;
     }
-    dot(e[0], cross(e[1], e[2]))
+    e[0].dot(&e[1].cross(&e[2]))
 }
 
 fn hex_coords(mesh: &Mesh, cell: usize) -> [[f64; 3]; 8] {
@@ -97,20 +98,16 @@ fn hex_coords(mesh: &Mesh, cell: usize) -> [[f64; 3]; 8] {
 }
 
 /// Jacobian matrix ∂x/∂(ξ, η, ζ) (rows x, y, z) of a trilinear hex at natural point `xi`.
-fn hex_jacobian(x: &[[f64; 3]; 8], xi: [f64; 3]) -> [[f64; 3]; 3] {
-    let mut j = [[0.0; 3]; 3];
+fn hex_jacobian(x: &[[f64; 3]; 8], xi: [f64; 3]) -> Mat3 {
+    let mut j = Mat3::zeros();
     for (a, n) in HEX_NATURAL.iter().enumerate() {
         let f = [1.0 + n[0] * xi[0], 1.0 + n[1] * xi[1], 1.0 + n[2] * xi[2]];
-        let grad = [
+        let grad = Vec3::new(
             0.125 * n[0] * f[1] * f[2],
             0.125 * n[1] * f[0] * f[2],
             0.125 * n[2] * f[0] * f[1],
-        ];
-        for r in 0..3 {
-            for c in 0..3 {
-                j[r][c] += x[a][r] * grad[c];
-            }
-        }
+        );
+        j += Vec3::from(x[a]) * grad.transpose();
     }
     j
 }
@@ -119,7 +116,7 @@ fn hex_jacobian(x: &[[f64; 3]; 8], xi: [f64; 3]) -> [[f64; 3]; 3] {
 /// natural volume]; each Gauss weight is 1.
 fn hex_gauss_dets(x: &[[f64; 3]; 8]) -> [f64; 8] {
     let g = 1.0 / 3f64.sqrt();
-    HEX_NATURAL.map(|n| det3(hex_jacobian(x, n.map(|s| s * g))))
+    HEX_NATURAL.map(|n| hex_jacobian(x, n.map(|s| s * g)).determinant())
 }
 
 /// Volume of hex `cell` by 2 × 2 × 2 Gauss quadrature [m³].
@@ -178,8 +175,9 @@ fn check_face(
         ));
     }
     let normal = newell_normal(&mesh.nodes, nodes);
-    let away = sub(centroid(&mesh.nodes, nodes), cell_centroid(mesh, cell));
-    if dot(normal, away) <= 0.0 {
+    let away = centroid(&mesh.nodes, nodes) - cell_centroid(mesh, cell);
+    if normal.dot(&away) <= 0.0 {
+        let normal = [normal[0], normal[1], normal[2]];
         return Err(format!(
             "face {face:?} has normal {normal:?} pointing into cell {cell}"
         ));
@@ -194,8 +192,8 @@ fn same_cycle(a: &[usize], b: &[usize]) -> bool {
 }
 
 /// Newell's area-weighted normal of a polygon (right-hand rule over the node order).
-fn newell_normal(nodes: &[[f64; 3]], poly: &[usize]) -> [f64; 3] {
-    let mut n = [0.0; 3];
+fn newell_normal(nodes: &[[f64; 3]], poly: &[usize]) -> Vec3 {
+    let mut n = Vec3::zeros();
     for k in 0..poly.len() {
         let p = nodes[poly[k]];
         let q = nodes[poly[(k + 1) % poly.len()]];
@@ -206,47 +204,17 @@ fn newell_normal(nodes: &[[f64; 3]], poly: &[usize]) -> [f64; 3] {
     n
 }
 
-fn centroid(nodes: &[[f64; 3]], ids: &[usize]) -> [f64; 3] {
-    let mut c = [0.0; 3];
-    for &i in ids {
-        for k in 0..3 {
-            c[k] += nodes[i][k] / ids.len() as f64;
-        }
-    }
-    c
+fn centroid(nodes: &[[f64; 3]], ids: &[usize]) -> Vec3 {
+    ids.iter().map(|&i| Vec3::from(nodes[i])).sum::<Vec3>() / ids.len() as f64
 }
 
-fn cell_centroid(mesh: &Mesh, cell: usize) -> [f64; 3] {
+fn cell_centroid(mesh: &Mesh, cell: usize) -> Vec3 {
     let nh = mesh.hexes.len();
     if cell < nh {
         centroid(&mesh.nodes, &mesh.hexes[cell])
     } else {
         centroid(&mesh.nodes, &mesh.tets[cell - nh])
     }
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
-}
-
-fn det3(m: [[f64; 3]; 3]) -> f64 {
-    dot(m[0], cross(m[1], m[2]))
 }
 
 #[cfg(test)]
