@@ -1008,6 +1008,7 @@ fn bench_dynamic(n: usize, steps: usize, threads: usize) -> DynamicResult {
             density: DENSITY,
             initial_velocity: [0.0; 3],
             element: Default::default(),
+            plane_strain: false,
         }],
         dirichlet: vec![
             Dirichlet {

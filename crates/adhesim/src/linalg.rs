@@ -115,6 +115,52 @@ impl BlockPattern {
         (ext, map)
     }
 
+    /// The pattern of Tᵀ A T for the node map T that gives node n the unknowns of node
+    /// `rep[n]` (`rep[rep[n]] == rep[n]`): every block (a, b) moves to (rep a, rep b), and a
+    /// node with rep[n] ≠ n keeps only its diagonal block (which stays empty). Returns it with,
+    /// for each stored value of `self`, its position in the new pattern and its factor: 2 for a
+    /// diagonal entry of an off-diagonal block (a, b) with rep a = rep b, which stands for both
+    /// A_ab and A_ba there, 1 otherwise.
+    pub fn condensed(&self, rep: &[usize]) -> (BlockPattern, Vec<(usize, f64)>) {
+        let mut nbrs: Vec<Vec<usize>> = (0..self.num_nodes).map(|b| vec![b]).collect();
+        for b in 0..self.num_nodes {
+            for &a in &self.upper_neighbours[b] {
+                let (ra, rb) = (rep[a], rep[b]);
+                nbrs[ra.max(rb)].push(ra.min(rb));
+            }
+        }
+        for list in nbrs.iter_mut() {
+            list.sort_unstable();
+            list.dedup();
+        }
+        let out = BlockPattern::from_neighbours(self.num_nodes, nbrs);
+        let mut map = vec![(0usize, 0.0); self.nnz()];
+        for b in 0..self.num_nodes {
+            for (r, &a) in self.upper_neighbours[b].iter().enumerate() {
+                for k in 0..3 {
+                    let rows = if a == b { k + 1 } else { 3 };
+                    for i in 0..rows {
+                        map[self.position(r, b, i, k)] = out.entry(3 * rep[a] + i, 3 * rep[b] + k);
+                    }
+                }
+                if a != b && rep[a] == rep[b] {
+                    for k in 0..3 {
+                        map[self.position(r, b, k, k)].1 = 2.0;
+                    }
+                }
+            }
+        }
+        (out, map)
+    }
+
+    /// Position and factor 1 of scalar entry (i, j) or (j, i), whichever is stored.
+    fn entry(&self, i: usize, j: usize) -> (usize, f64) {
+        let (i, j) = (i.min(j), i.max(j));
+        let (a, b) = (i / 3, j / 3);
+        let rank = self.rank(a, b).expect("the pattern holds the block");
+        (self.position(rank, b, i % 3, j % 3), 1.0)
+    }
+
     /// Number of stored values.
     pub fn nnz(&self) -> usize {
         self.row_idx.len()
@@ -221,6 +267,19 @@ pub fn metis_dof_ordering(pattern: &BlockPattern) -> Result<(Vec<usize>, Vec<usi
         inv[old] = new;
     }
     Ok((fwd, inv))
+}
+
+/// Something that solves A X = B in place for a column-major block of right-hand sides
+/// (`rhs.len()` a multiple of the dimension) with a factorisation it holds.
+pub trait LinearSolve {
+    /// Overwrites each column of `rhs` with A⁻¹ times it.
+    fn solve_in_place(&mut self, rhs: &mut [f64]);
+}
+
+impl LinearSolve for SparseCholesky {
+    fn solve_in_place(&mut self, rhs: &mut [f64]) {
+        SparseCholesky::solve_in_place(self, rhs);
+    }
 }
 
 /// A sparse Cholesky factorisation whose symbolic part is reused across numeric

@@ -59,6 +59,10 @@ pub struct Body {
     pub initial_velocity: [f64; 3],
     /// Element kinematics of the body's hexahedra (standard or F-bar).
     pub element: crate::fbar::Formulation,
+    /// Plane strain in the x-y plane (docs/model.md §1): the nodes of a line through the
+    /// thickness move alike (their out-of-plane displacement is held by a Dirichlet
+    /// condition of the problem).
+    pub plane_strain: bool,
 }
 
 /// Time integration settings (docs/model.md §3).

@@ -528,6 +528,7 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
             density,
             initial_velocity,
             element,
+            plane_strain: b.plane_strain,
         });
     }
     let offsets = {

@@ -5,60 +5,88 @@
 //! The extension only grows: a coupling, once added, stays, so the symbolic analysis (METIS
 //! ordering and elimination tree) is redone only when contact reaches a face pair it has never
 //! touched before, not at every step.
+//!
+//! Nodes may be tied: node n then has the unknowns of its representative `rep[n]` (the nodes
+//! of a line through a plane-strain slab, docs/model.md §1). The matrix factorised is Tᵀ K̄ T
+//! for that map T, in which a tied node keeps only a unit diagonal; solving adds a tied node's
+//! right-hand side to its representative's and copies the solution back.
 
-use crate::linalg::{BlockPattern, LinalgError, SparseCholesky};
+use crate::linalg::{BlockPattern, LinalgError, LinearSolve, SparseCholesky};
 use std::collections::BTreeSet;
 
 /// K̄ in the (possibly extended) pattern, with its factorisation.
 pub struct SystemMatrix {
-    /// The element pattern (what the assembly fills).
-    base: BlockPattern,
-    /// The pattern in use: `base` plus `couplings`.
+    /// Representative of each node (itself unless tied).
+    rep: Vec<usize>,
+    /// The tied nodes with their representatives.
+    tied_nodes: Vec<(usize, usize)>,
+    /// The element pattern with the ties applied.
+    tied: BlockPattern,
+    /// The pattern in use: `tied` plus `couplings`.
     pattern: BlockPattern,
-    /// Position in `pattern` of each value of `base` (None while the two are the same).
-    base_to_ext: Option<Vec<usize>>,
-    /// Node couplings added by contact, as (smaller, larger) node indices.
+    /// Position in `tied` and factor of each value of the element pattern (what the
+    /// assembly fills).
+    base_to_tied: Vec<(usize, f64)>,
+    /// Position in `pattern` of each value of `tied` (None while the two are the same).
+    tied_to_ext: Option<Vec<usize>>,
+    /// Node couplings added by contact, as (smaller, larger) representative nodes.
     couplings: BTreeSet<(usize, usize)>,
-    /// Whether each scalar unknown is prescribed.
-    constrained: Vec<bool>,
-    /// Off-diagonal positions in a constrained row or column (zeroed).
+    /// Whether each scalar unknown has a zero row and column with a positive diagonal in the
+    /// factorised matrix: prescribed unknowns and those of tied nodes.
+    fixed: Vec<bool>,
+    /// Off-diagonal positions in a fixed row or column (zeroed).
     zero_positions: Vec<usize>,
     /// Values of K̄ in `pattern` (upper triangle).
-    pub values: Vec<f64>,
+    values: Vec<f64>,
     chol: SparseCholesky,
     /// Symbolic analyses done since the start (1 for the element pattern).
     pub analyses: usize,
 }
 
 impl SystemMatrix {
-    /// Analyses the element pattern.
-    pub fn new(base: BlockPattern, constrained: Vec<bool>) -> Result<Self, LinalgError> {
-        let chol = SparseCholesky::analyse(&base, 0)?;
-        let zero_positions = zero_positions(&base, &constrained);
+    /// Analyses the element pattern with the prescribed unknowns `constrained` and the node
+    /// representatives `rep` (`rep[n] == n` for a node that is not tied; a tied node and its
+    /// representative must have the same prescribed components).
+    pub fn new(
+        base: BlockPattern,
+        constrained: Vec<bool>,
+        rep: Vec<usize>,
+    ) -> Result<Self, LinalgError> {
+        let (tied, base_to_tied) = base.condensed(&rep);
+        let chol = SparseCholesky::analyse(&tied, 0)?;
+        let fixed: Vec<bool> = constrained
+            .iter()
+            .enumerate()
+            .map(|(d, &c)| c || rep[d / 3] != d / 3)
+            .collect();
+        let zero_positions = zero_positions(&tied, &fixed);
+        let tied_nodes = (0..rep.len())
+            .filter(|&t| rep[t] != t)
+            .map(|t| (t, rep[t]))
+            .collect();
         Ok(SystemMatrix {
-            values: vec![0.0; base.nnz()],
-            pattern: base.clone(),
-            base,
-            base_to_ext: None,
+            tied_nodes,
+            values: vec![0.0; tied.nnz()],
+            pattern: tied.clone(),
+            rep,
+            tied,
+            base_to_tied,
+            tied_to_ext: None,
             couplings: BTreeSet::new(),
-            constrained,
+            fixed,
             zero_positions,
             chol,
             analyses: 1,
         })
     }
 
-    /// The pattern in use.
-    pub fn pattern(&self) -> &BlockPattern {
-        &self.pattern
-    }
-
     /// Makes sure the pattern holds the node couplings `pairs`; re-analyses when it grows.
     pub fn ensure_couplings(&mut self, pairs: &[(usize, usize)]) -> Result<(), LinalgError> {
         let mut grew = false;
         for &(a, b) in pairs {
+            let (a, b) = (self.rep[a], self.rep[b]);
             let key = (a.min(b), a.max(b));
-            if key.0 != key.1 && self.base.rank(key.0, key.1).is_none() {
+            if key.0 != key.1 && self.tied.rank(key.0, key.1).is_none() {
                 grew |= self.couplings.insert(key);
             }
         }
@@ -66,12 +94,12 @@ impl SystemMatrix {
             return Ok(());
         }
         let all: Vec<(usize, usize)> = self.couplings.iter().copied().collect();
-        let (ext, map) = self.base.with_extra_pairs(&all);
+        let (ext, map) = self.tied.with_extra_pairs(&all);
         self.chol = SparseCholesky::analyse(&ext, 0)?;
-        self.zero_positions = zero_positions(&ext, &self.constrained);
+        self.zero_positions = zero_positions(&ext, &self.fixed);
         self.values = vec![0.0; ext.nnz()];
         self.pattern = ext;
-        self.base_to_ext = Some(map);
+        self.tied_to_ext = Some(map);
         self.analyses += 1;
         Ok(())
     }
@@ -79,21 +107,56 @@ impl SystemMatrix {
     /// Sets K̄ = Σ cᵢ Aᵢ from matrices in the element pattern (`terms` of (c, values)).
     pub fn set_from_base(&mut self, terms: &[(f64, &[f64])]) {
         self.values.iter_mut().for_each(|v| *v = 0.0);
-        for (q, slot) in
-            (0..self.base.nnz()).map(|q| (q, self.base_to_ext.as_ref().map_or(q, |map| map[q])))
-        {
-            self.values[slot] = terms.iter().map(|(c, a)| c * a[q]).sum();
+        let ext = self.tied_to_ext.as_deref();
+        for (q, &(slot, factor)) in self.base_to_tied.iter().enumerate() {
+            let slot = ext.map_or(slot, |map| map[slot]);
+            let v: f64 = terms.iter().map(|(c, a)| c * a[q]).sum();
+            self.values[slot] += if factor == 1.0 { v } else { factor * v };
         }
     }
 
-    /// Applies the Dirichlet conditions (zero constrained rows and columns, a positive
+    /// Adds the block K_ab [N/m] coupling the unknowns of nodes a and b (and, for a ≠ b, its
+    /// transpose K_ba); for a = b the block must be symmetric. The pattern must hold the
+    /// coupling (see [`Self::ensure_couplings`]).
+    pub fn add_block(&mut self, a: usize, b: usize, block: &[[f64; 3]; 3]) {
+        let (ra, rb) = (self.rep[a], self.rep[b]);
+        let p = &self.pattern;
+        let mut add = |i: usize, j: usize, v: f64| {
+            let (i, j) = (i.min(j), i.max(j));
+            let rank = p
+                .rank(i / 3, j / 3)
+                .expect("the pattern holds the contact couplings");
+            self.values[p.position(rank, j / 3, i % 3, j % 3)] += v;
+        };
+        if ra == rb {
+            // K_aa, or K_ab + K_ba on the representative's diagonal block.
+            for i in 0..3 {
+                for k in i..3 {
+                    let v = if a == b {
+                        block[i][k]
+                    } else {
+                        block[i][k] + block[k][i]
+                    };
+                    add(3 * ra + i, 3 * ra + k, v);
+                }
+            }
+        } else {
+            for i in 0..3 {
+                for k in 0..3 {
+                    add(3 * ra + i, 3 * rb + k, block[i][k]);
+                }
+            }
+        }
+    }
+
+    /// Applies the Dirichlet conditions and the ties (zero fixed rows and columns, a positive
     /// diagonal) and factorises.
     pub fn factorise(&mut self) -> Result<(), LinalgError> {
         for &q in &self.zero_positions {
             self.values[q] = 0.0;
         }
-        for d in 0..self.constrained.len() {
-            if self.constrained[d] {
+        for d in 0..self.fixed.len() {
+            if self.fixed[d] {
                 let q = self.pattern.diagonal_position(d);
                 if !(self.values[q] > 0.0) {
                     self.values[q] = 1.0;
@@ -103,24 +166,44 @@ impl SystemMatrix {
         self.chol.factorise(&self.values)
     }
 
-    /// The factorisation (after [`Self::factorise`]).
-    pub fn cholesky(&mut self) -> &mut SparseCholesky {
-        &mut self.chol
-    }
-
-    /// Solves K̄ x = b in place.
+    /// Solves K̄ x = b in place, for one or more right-hand sides (column-major).
     pub fn solve_in_place(&mut self, rhs: &mut [f64]) {
+        let (n, tied) = (self.fixed.len(), &self.tied_nodes);
+        if n == 0 {
+            return;
+        }
+        for col in rhs.chunks_exact_mut(n) {
+            for &(t, r) in tied {
+                for k in 0..3 {
+                    col[3 * r + k] += col[3 * t + k];
+                    col[3 * t + k] = 0.0;
+                }
+            }
+        }
         self.chol.solve_in_place(rhs);
+        for col in rhs.chunks_exact_mut(n) {
+            for &(t, r) in tied {
+                for k in 0..3 {
+                    col[3 * t + k] = col[3 * r + k];
+                }
+            }
+        }
     }
 }
 
-/// Off-diagonal positions of `pattern` in a row or column of a constrained unknown.
-fn zero_positions(pattern: &BlockPattern, constrained: &[bool]) -> Vec<usize> {
+impl LinearSolve for SystemMatrix {
+    fn solve_in_place(&mut self, rhs: &mut [f64]) {
+        SystemMatrix::solve_in_place(self, rhs);
+    }
+}
+
+/// Off-diagonal positions of `pattern` in a fixed row or column.
+fn zero_positions(pattern: &BlockPattern, fixed: &[bool]) -> Vec<usize> {
     let mut out = Vec::new();
     for j in 0..pattern.dim() {
         for q in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
             let i = pattern.row_idx[q];
-            if i != j && (constrained[i] || constrained[j]) {
+            if i != j && (fixed[i] || fixed[j]) {
                 out.push(q);
             }
         }
@@ -139,7 +222,7 @@ mod tests {
         let base = BlockPattern::from_cells(4, cells.iter().map(|c| &c[..]));
         let mut constrained = vec![false; 12];
         constrained[0..3].iter_mut().for_each(|c| *c = true); // node 0 fixed
-        let mut sys = SystemMatrix::new(base.clone(), constrained).unwrap();
+        let mut sys = SystemMatrix::new(base.clone(), constrained, (0..4).collect()).unwrap();
         let mut k = vec![0.0; base.nnz()];
         for c in cells {
             for &b in &c {
@@ -165,12 +248,10 @@ mod tests {
         assert_eq!(sys.analyses, 2, "a known coupling does not re-analyse");
         sys.set_from_base(&[(1.0, &k)]);
         // Contact spring of stiffness 1 along x between nodes 1 and 2.
-        let p = sys.pattern().clone();
-        let r = p.rank(1, 2).unwrap();
-        sys.values[p.position(r, 2, 0, 0)] -= 1.0;
+        let x_spring = |k: f64| [[k, 0.0, 0.0], [0.0; 3], [0.0; 3]];
+        sys.add_block(1, 2, &x_spring(-1.0));
         for n in [1, 2] {
-            let q = p.position(p.rank(n, n).unwrap(), n, 0, 0);
-            sys.values[q] += 1.0;
+            sys.add_block(n, n, &x_spring(1.0));
         }
         sys.factorise().unwrap();
         // Pull node 3 along x by 1: springs 0-1, 1-2, 2-3 in series (k = 2, 1, 2 at the free
@@ -184,5 +265,111 @@ mod tests {
         let x3 = (3.0 * 3.0 - 1.0) / det;
         assert!((b[9] - x3).abs() < 1e-14, "{} vs {x3}", b[9]);
         assert_eq!(b[0], 0.0);
+    }
+
+    /// Dense solve of a small system by Gaussian elimination with partial pivoting.
+    fn dense_solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
+        let n = b.len();
+        for c in 0..n {
+            let p = (c..n)
+                .max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))
+                .unwrap();
+            a.swap(c, p);
+            b.swap(c, p);
+            for r in c + 1..n {
+                let f = a[r][c] / a[c][c];
+                for k in c..n {
+                    a[r][k] -= f * a[c][k];
+                }
+                b[r] -= f * b[c];
+            }
+        }
+        let mut x = vec![0.0; n];
+        for r in (0..n).rev() {
+            x[r] = (b[r] - (r + 1..n).map(|k| a[r][k] * x[k]).sum::<f64>()) / a[r][r];
+        }
+        x
+    }
+
+    /// Nodes 2 and 3 tied to nodes 0 and 1, z held everywhere (a plane-strain slab of one
+    /// element): the solve equals the dense solve of Tᵀ K T y = Tᵀ b with x = T y, to
+    /// round-off, with an element matrix and a contact block between tied nodes added.
+    #[test]
+    fn tied_nodes_solve_the_condensed_system() {
+        let cell = [0usize, 1, 2, 3];
+        let base = BlockPattern::from_cells(4, std::iter::once(&cell[..]));
+        let constrained: Vec<bool> = (0..12).map(|d| d % 3 == 2).collect();
+        let mut sys =
+            SystemMatrix::new(base.clone(), constrained.clone(), vec![0, 1, 0, 1]).unwrap();
+        // A dense SPD K = AᵀA + 12 I with a fixed uneven A, stored in the element pattern.
+        let a: Vec<f64> = (0..144)
+            .map(|k| ((k * 29 % 13) as f64 - 6.0) * 0.1)
+            .collect();
+        let mut k = vec![vec![0.0; 12]; 12];
+        for (i, row) in k.iter_mut().enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = (0..12).map(|r| a[r * 12 + i] * a[r * 12 + j]).sum::<f64>()
+                    + if i == j { 12.0 } else { 0.0 };
+            }
+        }
+        let mut values = vec![0.0; base.nnz()];
+        for bn in 0..4 {
+            for an in 0..=bn {
+                let r = base.rank(an, bn).unwrap();
+                for kk in 0..3 {
+                    let rows = if an == bn { kk + 1 } else { 3 };
+                    for i in 0..rows {
+                        values[base.position(r, bn, i, kk)] = k[3 * an + i][3 * bn + kk];
+                    }
+                }
+            }
+        }
+        sys.set_from_base(&[(1.0, &values)]);
+        // A contact block between node 0 and its tied twin 2, and one between 1 and 2.
+        let c02 = [[2.0, 0.5, 0.0], [0.25, 1.0, 0.0], [0.0, 0.0, 0.0]];
+        let c12 = [[-1.0, 0.0, 0.0], [0.0, -0.5, 0.0], [0.0, 0.0, 0.0]];
+        sys.add_block(0, 2, &c02);
+        sys.add_block(1, 2, &c12);
+        for (an, bn, c) in [(0, 2, c02), (1, 2, c12)] {
+            for i in 0..3 {
+                for j in 0..3 {
+                    k[3 * an + i][3 * bn + j] += c[i][j];
+                    k[3 * bn + j][3 * an + i] += c[i][j];
+                }
+            }
+        }
+        sys.factorise().unwrap();
+        let b: Vec<f64> = (0..12)
+            .map(|d| if d % 3 == 2 { 0.0 } else { 1.0 + d as f64 })
+            .collect();
+        let mut x = b.clone();
+        sys.solve_in_place(&mut x);
+        // Dense reference over the free unknowns (x, y of nodes 0 and 1): T maps (node 0,
+        // node 1) to all four nodes.
+        let free = [0usize, 1, 3, 4];
+        let t = |d: usize| d % 6; // the representative unknown of unknown d
+        let mut kc = vec![vec![0.0; 4]; 4];
+        let mut bc = vec![0.0; 4];
+        for i in (0..12).filter(|d| d % 3 != 2) {
+            let ri = free.iter().position(|&f| f == t(i)).unwrap();
+            bc[ri] += b[i];
+            for j in (0..12).filter(|d| d % 3 != 2) {
+                let rj = free.iter().position(|&f| f == t(j)).unwrap();
+                kc[ri][rj] += k[i][j];
+            }
+        }
+        let y = dense_solve(kc, bc);
+        for d in 0..12 {
+            let expected = if d % 3 == 2 {
+                0.0
+            } else {
+                y[free.iter().position(|&f| f == t(d)).unwrap()]
+            };
+            assert!(
+                (x[d] - expected).abs() <= 1e-12 * expected.abs().max(1e-3),
+                "unknown {d}: {} against {expected}",
+                x[d]
+            );
+        }
     }
 }

@@ -287,7 +287,8 @@ impl Stepper {
         let gravity_force =
             crate::gravity::unit_forces(n, |x, y| disc.pattern.symmetric_matvec(&mass, x, y));
         let constraints = Constraints::new(&problem.dirichlet, n);
-        let system = SystemMatrix::new(disc.pattern.clone(), constraints.mask().to_vec())?;
+        let ties = constraints::thickness_ties(&problem, constraints.mask());
+        let system = SystemMatrix::new(disc.pattern.clone(), constraints.mask().to_vec(), ties)?;
         let mut v0 = vec![0.0; n];
         let offsets = problem.node_offsets();
         for (b, off) in problem.bodies.iter().zip(offsets) {

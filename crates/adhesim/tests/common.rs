@@ -53,6 +53,7 @@ pub fn one_body(
             density,
             initial_velocity: [0.0; 3],
             element: Default::default(),
+            plane_strain: false,
         }],
         dirichlet: vec![],
         loads: vec![],

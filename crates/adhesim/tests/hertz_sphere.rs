@@ -255,6 +255,7 @@ fn indent_on(
             density: 1000.0,
             initial_velocity: [0.0; 3],
             element,
+            plane_strain: false,
         }],
         dirichlet: vec![
             fixed(mesh.node_sets["sym_x"].clone(), [true, false, false]),

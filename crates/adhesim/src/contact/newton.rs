@@ -24,7 +24,7 @@ use super::law::{
     adhesive_response, bipotential_trial, dry_projection, BondState, ContactState, InterfaceLaw,
     PointSolution,
 };
-use crate::linalg::BlockPattern;
+use crate::system::SystemMatrix;
 
 /// ρ_α as a multiple of the stiffness K̄ shows at contact point α: each multiplier update
 /// contracts the error by about 1/(1 + this) at an isolated point.
@@ -219,13 +219,12 @@ pub fn couplings(points: &[ContactPoint]) -> Vec<(usize, usize)> {
     pairs
 }
 
-/// Adds H_αᵀ k_α H_α of every point to the upper-triangle `values` of `pattern` (which must
-/// hold [`couplings`]).
+/// Adds H_αᵀ k_α H_α of every point to the system matrix (whose pattern must hold
+/// [`couplings`]).
 pub fn add_contact_tangent(
     points: &[ContactPoint],
     stiffness: &[[[f64; 3]; 3]],
-    pattern: &BlockPattern,
-    values: &mut [f64],
+    system: &mut SystemMatrix,
 ) {
     for (pt, k) in points.iter().zip(stiffness) {
         if k.iter().flatten().all(|&v| v == 0.0) {
@@ -252,18 +251,9 @@ pub fn add_contact_tangent(
             .collect();
         for &(a, ca) in &nodes {
             for &(b, cb) in &nodes {
-                if a > b {
-                    continue;
-                }
-                let rank = pattern
-                    .rank(a, b)
-                    .expect("the pattern holds the contact couplings");
-                let c = ca * cb;
-                for kk in 0..3 {
-                    let rows = if a == b { kk + 1 } else { 3 };
-                    for i in 0..rows {
-                        values[pattern.position(rank, b, i, kk)] += c * g[i][kk];
-                    }
+                if a <= b {
+                    let c = ca * cb;
+                    system.add_block(a, b, &g.map(|row| row.map(|v| c * v)));
                 }
             }
         }

@@ -4,7 +4,7 @@
 
 use super::detect::{dot, ContactPoint};
 use super::law::{default_rho, solve_point, BondState, InterfaceLaw, PointProblem, PointSolution};
-use crate::linalg::SparseCholesky;
+use crate::linalg::LinearSolve;
 
 /// The dense Delassus operator W = H K̄⁻¹ Hᵀ of the contact points.
 #[derive(Clone, Debug, PartialEq)]
@@ -26,7 +26,7 @@ fn w_columns(
     points: &[ContactPoint],
     start: usize,
     cols: usize,
-    chol: &mut SparseCholesky,
+    chol: &mut impl LinearSolve,
     constrained: &[bool],
     scratch: &mut [f64],
     out: &mut [f64],
@@ -57,7 +57,7 @@ fn w_columns(
 /// Builds W with the current factorisation, 64 columns of K̄⁻¹Hᵀ at a time.
 pub fn delassus(
     points: &[ContactPoint],
-    chol: &mut SparseCholesky,
+    chol: &mut impl LinearSolve,
     constrained: &[bool],
 ) -> Delassus {
     let n = constrained.len();
@@ -139,7 +139,7 @@ impl Delassus {
         &self,
         points: &[ContactPoint],
         probe: usize,
-        chol: &mut SparseCholesky,
+        chol: &mut impl LinearSolve,
         constrained: &[bool],
     ) -> f64 {
         let m = self.m;

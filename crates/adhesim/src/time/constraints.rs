@@ -1,7 +1,8 @@
 //! Every prescribed displacement of a problem in one place: which unknowns are fixed, their
 //! values at a time, and the quantities measured on them (reactions).
 
-use crate::problem::Dirichlet;
+use crate::contact::detect::{thickness_twins, Master};
+use crate::problem::{Dirichlet, Problem};
 
 /// The Dirichlet conditions of a problem and the mask of the unknowns they fix.
 #[derive(Clone, Debug)]
@@ -117,4 +118,46 @@ mod tests {
         );
         assert!((d - 17f64.sqrt()).abs() < 1e-15);
     }
+}
+
+/// The representative of each node (see [`crate::system::SystemMatrix`]). In a plane-strain
+/// body the nodes of one line through the thickness (same reference x and y) share the
+/// unknowns of the line's first node, provided they have the same prescribed components
+/// (`fixed`, per unknown) and every contact pair that touches the body makes such a line one
+/// contact point: the plane solution has them move alike, and the system then has a third
+/// of the unknowns of the slab. Every other node is its own representative.
+pub fn thickness_ties(problem: &Problem, fixed: &[bool]) -> Vec<usize> {
+    let offsets = problem.node_offsets();
+    let mut rep: Vec<usize> = (0..fixed.len() / 3).collect();
+    for (body, &offset) in problem.bodies.iter().zip(&offsets) {
+        let nodes = offset..offset + body.mesh.num_nodes();
+        let touches = |pair: &crate::contact::ContactPair| {
+            pair.slave_nodes.iter().any(|n| nodes.contains(n))
+                || matches!(&pair.master, Master::Faces(faces)
+                    if faces.iter().any(|f| f.nodes().iter().any(|n| nodes.contains(n))))
+        };
+        let plane_pairs = problem
+            .contacts
+            .iter()
+            .filter(|pair| touches(pair))
+            .all(|pair| pair.thickness_twins.iter().any(|t| !t.is_empty()));
+        if !body.plane_strain || !plane_pairs {
+            continue;
+        }
+        let local: Vec<usize> = (0..body.mesh.num_nodes()).collect();
+        let same_fixed = |a: usize, b: usize| fixed[3 * a..3 * a + 3] == fixed[3 * b..3 * b + 3];
+        for (i, twins) in thickness_twins(&local, &body.mesh.nodes).iter().enumerate() {
+            let first = twins
+                .iter()
+                .copied()
+                .chain([i])
+                .min()
+                .expect("the line holds i");
+            let line_alike = twins.iter().all(|&j| same_fixed(offset + i, offset + j));
+            if line_alike {
+                rep[offset + i] = offset + first;
+            }
+        }
+    }
+    rep
 }

@@ -114,12 +114,12 @@ impl<'a> DelassusCoupling<'a> {
                 .unwrap_or(0);
             let cached = &self.cache.as_ref().expect("checked").w;
             let mask = self.sc.constraints.mask();
-            reusable = cached.probed_change(&self.sc.points, probe, system.cholesky(), mask)
-                <= DELASSUS_STALE_TOL;
+            reusable =
+                cached.probed_change(&self.sc.points, probe, system, mask) <= DELASSUS_STALE_TOL;
         }
         if !reusable {
             let mask = self.sc.constraints.mask();
-            let del = delassus(&self.sc.points, system.cholesky(), mask);
+            let del = delassus(&self.sc.points, system, mask);
             *self.cache = Some(CachedDelassus {
                 key: self.key.clone(),
                 frames: self.sc.points.iter().map(|p| p.frame).collect(),

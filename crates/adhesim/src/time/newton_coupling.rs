@@ -171,8 +171,7 @@ impl<'a> ContactCoupling<'a> for NewtonCoupling<'a> {
             return;
         }
         let stiffness: Vec<_> = self.evals.iter().map(|e| e.stiffness).collect();
-        let pattern = system.pattern().clone();
-        newton::add_contact_tangent(&self.sc.points, &stiffness, &pattern, &mut system.values);
+        newton::add_contact_tangent(&self.sc.points, &stiffness, system);
     }
 
     fn correct(
