@@ -620,7 +620,7 @@ impl Stepper {
                     return [0.0; 3];
                 }
                 let [t1, t2] = c.tangent_axes;
-                let n = crate::contact::detect::cross(t1, t2);
+                let n = crate::Vec3::from(t1).cross(&crate::Vec3::from(t2));
                 // The node holds its share of the point's force.
                 let r = c.r_dry.map(|v| v / pt.node_share());
                 let g: [f64; 3] =

@@ -7,6 +7,7 @@ use super::anisotropic::aligned_frame;
 use super::law::InterfaceLaw;
 use crate::mesh::Face;
 use crate::prescribed::{rotate, Rotation, Table};
+use crate::Vec3;
 use std::collections::HashMap;
 
 /// An analytic rigid surface, in its reference position. Slave nodes must stay on the side
@@ -52,9 +53,9 @@ impl RigidMotion {
     pub fn apply(&self, x: [f64; 3], t: f64) -> [f64; 3] {
         let mut p = x;
         if let Some(r) = &self.rotation {
-            let d = sub(x, r.center);
-            let rd = rotate(d, r.axis, r.angle.at(t));
-            p = add(rd, r.center);
+            let d = Vec3::from(x) - Vec3::from(r.center);
+            let rd = rotate(d.into(), r.axis, r.angle.at(t));
+            p = (Vec3::from(rd) + Vec3::from(r.center)).into();
         }
         std::array::from_fn(|k| p[k] + self.translation[k].at(t))
     }
@@ -63,8 +64,9 @@ impl RigidMotion {
     pub fn inverse(&self, p: [f64; 3], t: f64) -> [f64; 3] {
         let mut x: [f64; 3] = std::array::from_fn(|k| p[k] - self.translation[k].at(t));
         if let Some(r) = &self.rotation {
-            let d = sub(x, r.center);
-            x = add(rotate(d, r.axis, -r.angle.at(t)), r.center);
+            let d = Vec3::from(x) - Vec3::from(r.center);
+            x = (Vec3::from(rotate(d.into(), r.axis, -r.angle.at(t))) + Vec3::from(r.center))
+                .into();
         }
         x
     }
@@ -158,10 +160,10 @@ pub fn tributary_areas(faces: &[Face], coords: &[[f64; 3]], nodes: &[usize]) -> 
 }
 
 fn face_area(ns: &[usize], x: &[[f64; 3]]) -> f64 {
-    let c = |i: usize| x[ns[i]];
+    let c = |i: usize| Vec3::from(x[ns[i]]);
     match ns.len() {
-        3 => 0.5 * norm(cross(sub(c(1), c(0)), sub(c(2), c(0)))),
-        _ => 0.5 * norm(cross(sub(c(2), c(0)), sub(c(3), c(1)))),
+        3 => 0.5 * (c(1) - c(0)).cross(&(c(2) - c(0))).norm(),
+        _ => 0.5 * (c(2) - c(0)).cross(&(c(3) - c(1))).norm(),
     }
 }
 
@@ -217,10 +219,10 @@ impl ContactPoint {
     /// Local relative displacement x = (slip increment t₁, t₂, end gap n) for the end-of-step
     /// displacement `u` [m] (H applied to u plus the constant part).
     pub fn local_x(&self, reference: &[[f64; 3]], u: &[f64]) -> [f64; 3] {
-        let d1 = self.relative_position(reference, u);
-        let f = &self.frame;
-        let ds = sub(d1, self.d0);
-        [dot(f[0], ds), dot(f[1], ds), dot(f[2], d1)]
+        let d1 = Vec3::from(self.relative_position(reference, u));
+        let f = self.frame.map(Vec3::from);
+        let ds = d1 - Vec3::from(self.d0);
+        [f[0].dot(&ds), f[1].dot(&ds), f[2].dot(&d1)]
     }
 
     fn relative_position(&self, reference: &[[f64; 3]], u: &[f64]) -> [f64; 3] {
@@ -231,7 +233,7 @@ impl ContactPoint {
             }
         }
         if self.master.is_empty() {
-            return sub(xs, self.master_point_end);
+            return (Vec3::from(xs) - Vec3::from(self.master_point_end)).into();
         }
         let mut xm = [0.0; 3];
         for &(m, w) in &self.master {
@@ -239,7 +241,7 @@ impl ContactPoint {
                 xm[k] += w * (reference[m][k] + u[3 * m + k]);
             }
         }
-        sub(xs, xm)
+        (Vec3::from(xs) - Vec3::from(xm)).into()
     }
 
     /// Adds Hᵀ r (r in local axes) to a global vector.
@@ -271,8 +273,8 @@ impl ContactPoint {
                 d[k] -= w * v[3 * m + k];
             }
         }
-        let f = &self.frame;
-        [dot(f[0], d), dot(f[1], d), dot(f[2], d)]
+        let (f, d) = (self.frame.map(Vec3::from), Vec3::from(d));
+        [f[0].dot(&d), f[1].dot(&d), f[2].dot(&d)]
     }
 }
 
@@ -344,7 +346,7 @@ impl Projection {
             frame: frame_from_normal(self.normal),
             master: self.master,
             master_point_end: self.end,
-            d0: sub(self.slave, self.start),
+            d0: (Vec3::from(self.slave) - Vec3::from(self.start)).into(),
             twins: Vec::new(),
         }
     }
@@ -387,9 +389,9 @@ fn project_slave(
                     continue;
                 }
                 let (xm, normal, weights) = project_on_face(face, pos, xs);
-                let d = sub(xs, xm);
-                let dist = norm(d);
-                let gap = dot(d, normal);
+                let d = Vec3::from(xs) - Vec3::from(xm);
+                let dist = d.norm();
+                let gap = d.dot(&Vec3::from(normal));
                 // Accept points on the outer side (or slightly penetrated) whose projection
                 // is close to the face.
                 if dist > pair.detection_distance || gap < -pair.detection_distance {
@@ -425,12 +427,12 @@ fn line_point(
     let mean = |f: &dyn Fn(&Projection) -> [f64; 3]| -> [f64; 3] {
         std::array::from_fn(|k| found.iter().map(|p| share * f(p)[k]).sum())
     };
-    let normal = mean(&|p| p.normal);
-    let in_plane = [normal[0], normal[1], 0.0];
-    let normal = if norm(in_plane) > 0.0 {
-        normalize(in_plane)
+    let normal = Vec3::from(mean(&|p| p.normal));
+    let in_plane = Vec3::new(normal[0], normal[1], 0.0);
+    let normal = if in_plane.norm() > 0.0 {
+        unit(in_plane)
     } else {
-        normalize(normal)
+        unit(normal)
     };
     let mut master: Vec<(usize, f64)> = Vec::new();
     for (m, w) in found.iter().flat_map(|p| p.master.iter().copied()) {
@@ -444,10 +446,10 @@ fn line_point(
         local: line[0],
         slave: pair.slave_nodes[line[0]],
         area: line.iter().map(|&l| pair.slave_area[l]).sum(),
-        frame: frame_from_normal(normal),
+        frame: frame_from_normal(normal.into()),
         master,
         master_point_end: mean(&|p| p.end),
-        d0: sub(mean(&|p| p.slave), mean(&|p| p.start)),
+        d0: (Vec3::from(mean(&|p| p.slave)) - Vec3::from(mean(&|p| p.start))).into(),
         twins: line[1..]
             .iter()
             .map(|&l| (pair.slave_nodes[l], l))
@@ -460,14 +462,14 @@ fn line_point(
 pub fn rigid_projection(shape: &RigidShape, x: [f64; 3]) -> ([f64; 3], [f64; 3], f64) {
     match shape {
         RigidShape::Plane { point, normal } => {
-            let g = dot(sub(x, *point), *normal);
+            let g = (Vec3::from(x) - Vec3::from(*point)).dot(&Vec3::from(*normal));
             (std::array::from_fn(|k| x[k] - g * normal[k]), *normal, g)
         }
         RigidShape::Sphere { center, radius } => {
-            let d = sub(x, *center);
-            let r = norm(d);
-            let n = if r > 0.0 {
-                d.map(|v| v / r)
+            let d = Vec3::from(x) - Vec3::from(*center);
+            let r = d.norm();
+            let n: [f64; 3] = if r > 0.0 {
+                (d / r).into()
             } else {
                 [0.0, 1.0, 0.0]
             };
@@ -482,12 +484,12 @@ pub fn rigid_projection(shape: &RigidShape, x: [f64; 3]) -> ([f64; 3], [f64; 3],
             axis,
             radius,
         } => {
-            let d = sub(x, *point);
-            let along = dot(d, *axis);
-            let radial: [f64; 3] = std::array::from_fn(|k| d[k] - along * axis[k]);
-            let r = norm(radial);
-            let n = if r > 0.0 {
-                radial.map(|v| v / r)
+            let d = Vec3::from(x) - Vec3::from(*point);
+            let along = d.dot(&Vec3::from(*axis));
+            let radial = d - along * Vec3::from(*axis);
+            let r = radial.norm();
+            let n: [f64; 3] = if r > 0.0 {
+                (radial / r).into()
             } else {
                 [0.0, 1.0, 0.0]
             };
@@ -531,17 +533,17 @@ pub fn project_on_face(
                     0.25 * (1.0 + a),
                     0.25 * (1.0 - a),
                 ];
-                let comb = |c: [f64; 4]| -> [f64; 3] {
-                    std::array::from_fn(|k| (0..4).map(|i| c[i] * p[i][k]).sum())
+                let comb = |c: [f64; 4]| -> Vec3 {
+                    Vec3::from_fn(|k, _| (0..4).map(|i| c[i] * p[i][k]).sum())
                 };
                 (w, comb(w), comb(da), comb(db))
             };
             for _ in 0..20 {
                 let (_, xm, ta, tb) = eval(a, b);
-                let r = sub(x, xm);
+                let r = Vec3::from(x) - xm;
                 // Gauss-Newton on ‖x − x(ξ,η)‖².
-                let (g1, g2) = (dot(r, ta), dot(r, tb));
-                let (m11, m12, m22) = (dot(ta, ta), dot(ta, tb), dot(tb, tb));
+                let (g1, g2) = (r.dot(&ta), r.dot(&tb));
+                let (m11, m12, m22) = (ta.dot(&ta), ta.dot(&tb), tb.dot(&tb));
                 let det = m11 * m22 - m12 * m12;
                 if !(det > 0.0) {
                     break;
@@ -555,16 +557,17 @@ pub fn project_on_face(
                 }
             }
             let (w, xm, ta, tb) = eval(a, b);
-            let n = normalize(cross(ta, tb));
-            (xm, n, w.to_vec())
+            let n = unit(ta.cross(&tb));
+            (xm.into(), n.into(), w.to_vec())
         }
         Face::Tri(ns) => {
             let p: [[f64; 3]; 3] = ns.map(pos);
-            let (e1, e2) = (sub(p[1], p[0]), sub(p[2], p[0]));
-            let n = normalize(cross(e1, e2));
-            let r = sub(x, p[0]);
-            let (m11, m12, m22) = (dot(e1, e1), dot(e1, e2), dot(e2, e2));
-            let (g1, g2) = (dot(r, e1), dot(r, e2));
+            let [p0, p1, p2] = p.map(Vec3::from);
+            let (e1, e2) = (p1 - p0, p2 - p0);
+            let n: [f64; 3] = unit(e1.cross(&e2)).into();
+            let r = Vec3::from(x) - p0;
+            let (m11, m12, m22) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
+            let (g1, g2) = (r.dot(&e1), r.dot(&e2));
             let det = m11 * m22 - m12 * m12;
             let mut a = (m22 * g1 - m12 * g2) / det;
             let mut b = (m11 * g2 - m12 * g1) / det;
@@ -649,40 +652,23 @@ pub fn align_frames(points: &mut [ContactPoint], pairs: &[ContactPair]) {
 /// (so that for normals in the x-y plane of a plane-strain slab T₁ lies in that plane), or
 /// N × e_x when N is close to e_z.
 pub fn frame_from_normal(n: [f64; 3]) -> [[f64; 3]; 3] {
+    let nv = Vec3::from(n);
     let t1 = if n[2].abs() < 0.9 {
-        normalize(cross(n, [0.0, 0.0, 1.0]))
+        unit(nv.cross(&Vec3::z()))
     } else {
-        normalize(cross(n, [1.0, 0.0, 0.0]))
+        unit(nv.cross(&Vec3::x()))
     };
-    let t2 = cross(n, t1);
-    [t1, t2, n]
+    let t2 = nv.cross(&t1);
+    [t1.into(), t2.into(), n]
 }
 
-pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-pub(crate) fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-pub(crate) fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
-}
-pub(crate) fn normalize(a: [f64; 3]) -> [f64; 3] {
-    let n = norm(a);
+/// `a` scaled to unit length; e_y for the zero vector.
+fn unit(a: Vec3) -> Vec3 {
+    let n = a.norm();
     if n > 0.0 {
-        a.map(|v| v / n)
+        a / n
     } else {
-        [0.0, 1.0, 0.0]
+        Vec3::y()
     }
 }
 
@@ -690,6 +676,15 @@ pub(crate) fn normalize(a: [f64; 3]) -> [f64; 3] {
 mod tests {
     use super::*;
     use crate::prescribed::Rotation;
+
+    fn normalize(a: [f64; 3]) -> [f64; 3] {
+        unit(Vec3::from(a)).into()
+    }
+
+    /// ‖a − b‖.
+    fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+        (Vec3::from(a) - Vec3::from(b)).norm()
+    }
 
     #[test]
     fn frame_is_orthonormal_and_right_handed() {
@@ -699,13 +694,12 @@ mod tests {
             normalize([0.3, -0.4, 0.8]),
             normalize([1.0, 1.0, 0.0]),
         ] {
-            let [t1, t2, nn] = frame_from_normal(n);
-            assert!((dot(t1, t1) - 1.0).abs() < 1e-14 && (dot(t2, t2) - 1.0).abs() < 1e-14);
+            let [t1, t2, nn] = frame_from_normal(n).map(Vec3::from);
+            assert!((t1.norm() - 1.0).abs() < 1e-14 && (t2.norm() - 1.0).abs() < 1e-14);
             assert!(
-                dot(t1, t2).abs() < 1e-14 && dot(t1, nn).abs() < 1e-14 && dot(t2, nn).abs() < 1e-14
+                t1.dot(&t2).abs() < 1e-14 && t1.dot(&nn).abs() < 1e-14 && t2.dot(&nn).abs() < 1e-14
             );
-            let c = cross(t1, t2);
-            assert!(norm(sub(c, nn)) < 1e-14, "T1 × T2 must be N");
+            assert!((t1.cross(&t2) - nn).norm() < 1e-14, "T1 × T2 must be N");
         }
         // Normals in the x-y plane of a plane-strain slab keep T1 in that plane.
         let [t1, _, _] = frame_from_normal(normalize([0.6, 0.8, 0.0]));
@@ -735,12 +729,12 @@ mod tests {
         let x = [0.4, -0.7, 0.25];
         for t in [0.0, 0.3, 1.0, 2.0] {
             let back = m.inverse(m.apply(x, t), t);
-            assert!(norm(sub(back, x)) < 1e-14, "t = {t}");
+            assert!(dist(back, x) < 1e-14, "t = {t}");
         }
         // Distances between material points are preserved (rigid).
         let y = [0.0, 0.1, -0.2];
-        let d0 = norm(sub(x, y));
-        let d1 = norm(sub(m.apply(x, 0.6), m.apply(y, 0.6)));
+        let d0 = dist(x, y);
+        let d1 = dist(m.apply(x, 0.6), m.apply(y, 0.6));
         assert!((d0 - d1).abs() < 1e-14);
     }
 
@@ -783,13 +777,13 @@ mod tests {
         // The weights are partition of unity and reproduce the projected point.
         assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-14);
         let xi: [f64; 3] = std::array::from_fn(|k| (0..4).map(|i| w[i] * nodes[i][k]).sum());
-        assert!(norm(sub(xi, xm)) < 1e-14);
+        assert!(dist(xi, xm) < 1e-14);
         // x − x_m is orthogonal to the surface tangents at the projection (an interior
         // closest point), hence parallel to the normal.
-        let d = sub(x, xm);
-        assert!(norm(cross(d, n)) < 1e-9 * norm(d), "not along the normal");
+        let (d, n) = (Vec3::from(x) - Vec3::from(xm), Vec3::from(n));
+        assert!(d.cross(&n).norm() < 1e-9 * d.norm(), "not along the normal");
         assert!(
-            dot(d, n) > 0.0,
+            d.dot(&n) > 0.0,
             "the point is on the outer side of a counter-clockwise face"
         );
         // A point beyond an edge projects onto the face boundary (clamped).

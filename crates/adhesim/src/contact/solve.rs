@@ -2,9 +2,10 @@
 //! W = H K̄⁻¹ Hᵀ from one multi-right-hand-side solve with the iteration's factorisation, and
 //! a nonlinear Gauss-Seidel sweep over contact points with the local bi-potential/RCC solve.
 
-use super::detect::{dot, ContactPoint};
+use super::detect::ContactPoint;
 use super::law::{default_rho, solve_point, BondState, InterfaceLaw, PointProblem, PointSolution};
 use crate::linalg::LinearSolve;
+use crate::Mat3;
 
 /// The dense Delassus operator W = H K̄⁻¹ Hᵀ of the contact points.
 #[derive(Clone, Debug, PartialEq)]
@@ -102,30 +103,27 @@ impl Delassus {
     pub fn rotate_frames(&mut self, from: &[[[f64; 3]; 3]], to: &[[[f64; 3]; 3]]) {
         assert_eq!(from.len(), to.len());
         assert_eq!(3 * from.len(), self.m);
+        let mat = |f: &[[f64; 3]; 3]| Mat3::from_fn(|i, j| f[i][j]);
         // None where a point's frame is unchanged: its blocks stay bit for bit.
-        let rot: Vec<Option<[[f64; 3]; 3]>> = from
+        let rot: Vec<Option<Mat3>> = from
             .iter()
             .zip(to)
-            .map(|(f, t)| {
-                (f != t).then(|| std::array::from_fn(|i| std::array::from_fn(|j| dot(t[i], f[j]))))
-            })
+            .map(|(f, t)| (f != t).then(|| mat(t) * mat(f).transpose()))
             .collect();
-        const IDENTITY: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
         let m = self.m;
         for (a, ra) in rot.iter().enumerate() {
             for (b, rb) in rot.iter().enumerate() {
                 if ra.is_none() && rb.is_none() {
                     continue;
                 }
-                let (ra, rb) = (ra.unwrap_or(IDENTITY), rb.unwrap_or(IDENTITY));
-                let at = |k: usize, l: usize| self.w[(3 * a + k) * m + 3 * b + l];
-                // R_α W_αβ, then times R_βᵀ.
-                let left: [[f64; 3]; 3] = std::array::from_fn(|i| {
-                    std::array::from_fn(|l| (0..3).map(|k| ra[i][k] * at(k, l)).sum())
-                });
-                for (i, row) in left.iter().enumerate() {
-                    for (j, rbj) in rb.iter().enumerate() {
-                        self.w[(3 * a + i) * m + 3 * b + j] = dot(*row, *rbj);
+                let at = |i: usize, j: usize| (3 * a + i) * m + 3 * b + j;
+                let block = Mat3::from_fn(|i, j| self.w[at(i, j)]);
+                let turned = ra.unwrap_or_else(Mat3::identity)
+                    * block
+                    * rb.unwrap_or_else(Mat3::identity).transpose();
+                for i in 0..3 {
+                    for j in 0..3 {
+                        self.w[at(i, j)] = turned[(i, j)];
                     }
                 }
             }
