@@ -1,6 +1,8 @@
 //! Prescribed functions of time and of position, shared by boundary conditions, loads,
 //! gravity and rigid contact surfaces: piecewise-linear tables and rigid rotations.
 
+use crate::Vec3;
+
 /// A piecewise-linear function of time, constant beyond its first and last points.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Table {
@@ -49,14 +51,7 @@ pub struct Rotation {
 }
 
 /// Rodrigues rotation of vector `v` about unit `axis` by `angle` [rad].
-pub fn rotate(v: [f64; 3], axis: [f64; 3], angle: f64) -> [f64; 3] {
+pub fn rotate(v: Vec3, axis: Vec3, angle: f64) -> Vec3 {
     let (s, c) = angle.sin_cos();
-    let k = axis;
-    let kxv = [
-        k[1] * v[2] - k[2] * v[1],
-        k[2] * v[0] - k[0] * v[2],
-        k[0] * v[1] - k[1] * v[0],
-    ];
-    let kdv = k[0] * v[0] + k[1] * v[1] + k[2] * v[2];
-    std::array::from_fn(|i| v[i] * c + kxv[i] * s + k[i] * kdv * (1.0 - c))
+    v * c + axis.cross(&v) * s + axis * axis.dot(&v) * (1.0 - c)
 }

@@ -25,8 +25,8 @@ impl Dirichlet {
     pub fn displacement(&self, x: [f64; 3], t: f64) -> [f64; 3] {
         let mut u: [f64; 3] = std::array::from_fn(|k| self.translation[k].at(t));
         if let Some(r) = &self.rotation {
-            let d = std::array::from_fn(|k| x[k] - r.center[k]);
-            let rd = rotate(d, r.axis, r.angle.at(t));
+            let d: [f64; 3] = std::array::from_fn(|k| x[k] - r.center[k]);
+            let rd = rotate(d.into(), r.axis.into(), r.angle.at(t));
             for k in 0..3 {
                 u[k] += rd[k] - d[k];
             }
@@ -216,8 +216,8 @@ mod tests {
     #[test]
     fn rotation_about_y_turns_x_into_minus_z() {
         let r = rotate(
-            [1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
+            crate::Vec3::x(),
+            crate::Vec3::y(),
             std::f64::consts::FRAC_PI_2,
         );
         assert!((r[0]).abs() < 1e-15 && (r[2] + 1.0).abs() < 1e-15);

@@ -54,8 +54,8 @@ impl RigidMotion {
         let mut p = x;
         if let Some(r) = &self.rotation {
             let d = Vec3::from(x) - Vec3::from(r.center);
-            let rd = rotate(d.into(), r.axis, r.angle.at(t));
-            p = (Vec3::from(rd) + Vec3::from(r.center)).into();
+            let rd = rotate(d, r.axis.into(), r.angle.at(t));
+            p = (rd + Vec3::from(r.center)).into();
         }
         std::array::from_fn(|k| p[k] + self.translation[k].at(t))
     }
@@ -65,8 +65,7 @@ impl RigidMotion {
         let mut x: [f64; 3] = std::array::from_fn(|k| p[k] - self.translation[k].at(t));
         if let Some(r) = &self.rotation {
             let d = Vec3::from(x) - Vec3::from(r.center);
-            x = (Vec3::from(rotate(d.into(), r.axis, -r.angle.at(t))) + Vec3::from(r.center))
-                .into();
+            x = (rotate(d, r.axis.into(), -r.angle.at(t)) + Vec3::from(r.center)).into();
         }
         x
     }
@@ -74,7 +73,7 @@ impl RigidMotion {
     /// Rotates a direction from the reference orientation to time t.
     pub fn rotate_dir(&self, v: [f64; 3], t: f64) -> [f64; 3] {
         match &self.rotation {
-            Some(r) => rotate(v, r.axis, r.angle.at(t)),
+            Some(r) => rotate(v.into(), r.axis.into(), r.angle.at(t)).into(),
             None => v,
         }
     }
