@@ -28,8 +28,11 @@
 //!
 //! The iteration stops on Siconos's relative error ([`super::natural_map`]), ρ = 1.
 
-use faer::linalg::solvers::Solve;
-use faer::sparse::{SparseColMat, Triplet};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuSymbolicParams, NumericLu, SymbolicLu};
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::{Argsort, Pair, SparseColMatRef, SymbolicSparseColMat};
+use faer::{Conj, MatMut, Par, Spec};
 
 use super::law::{bipotential_trial, dry_projection, projection_jacobian};
 use super::natural_map::{natural_map_residual, relative_error};
@@ -83,8 +86,74 @@ fn natural_map_rho(
     theta
 }
 
+/// The Newton matrix's sparsity (that of W in 3×3 blocks, the same at every iteration), the
+/// order its values are listed in, its symbolic LU factorisation (supernodal: the simplicial
+/// one spent 83 % of the time on spheres-in-a-box) and the numeric factors' storage: set up
+/// once per solve.
+struct JacobianPattern {
+    symbolic: SymbolicSparseColMat<usize>,
+    order: Argsort<usize>,
+    lu: SymbolicLu<usize>,
+    numeric: NumericLu<usize, f64>,
+    mem: MemBuffer,
+}
+
+impl JacobianPattern {
+    /// The analysis of the pattern of the listed `entries` of an `n` × `n` matrix.
+    fn new(n: usize, entries: &[Pair<usize, usize>]) -> Option<Self> {
+        let (symbolic, order) = SymbolicSparseColMat::try_new_from_indices(n, n, entries).ok()?;
+        let params = LuSymbolicParams {
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+            ..Default::default()
+        };
+        let lu = factorize_symbolic_lu(symbolic.as_ref(), params).ok()?;
+        let req = StackReq::any_of(&[
+            lu.factorize_numeric_lu_scratch::<f64>(Par::Seq, Spec::default()),
+            lu.solve_in_place_scratch::<f64>(1, Par::Seq),
+        ]);
+        Some(JacobianPattern {
+            symbolic,
+            order,
+            lu,
+            numeric: NumericLu::new(),
+            mem: MemBuffer::try_new(req).ok()?,
+        })
+    }
+
+    /// Solves J d = `rhs` in place for J with `entries_values` listed in the analysed order;
+    /// false if the factorisation fails.
+    fn solve(&mut self, entries_values: &[f64], rhs: &mut [f64]) -> bool {
+        let jac = match faer::sparse::SparseColMat::new_from_argsort(
+            self.symbolic.clone(),
+            &self.order,
+            entries_values,
+        ) {
+            Ok(m) => m,
+            Err(_) => return false,
+        };
+        let a: SparseColMatRef<'_, usize, f64> = jac.as_ref();
+        let stack = MemStack::new(&mut self.mem);
+        let Ok(lu) =
+            self.lu
+                .factorize_numeric_lu(&mut self.numeric, a, Par::Seq, stack, Spec::default())
+        else {
+            return false;
+        };
+        let n = rhs.len();
+        let stack = MemStack::new(&mut self.mem);
+        lu.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(rhs, n, 1),
+            Par::Seq,
+            stack,
+        );
+        true
+    }
+}
+
 /// The Newton direction d with J d = −F at (r, x), or `None` if the factorisation fails or d
-/// is not finite.
+/// is not finite. `pattern` holds the symbolic analysis of J's pattern (made on first use).
+#[allow(clippy::too_many_arguments)]
 fn newton_direction(
     w: &BlockSparseDelassus,
     mu: &[f64],
@@ -93,9 +162,11 @@ fn newton_direction(
     x: &[[f64; 3]],
     f: &[[f64; 3]],
     eta: f64,
+    pattern: &mut Option<JacobianPattern>,
 ) -> Option<Vec<f64>> {
     let n = w.points();
-    let mut triplets: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(9 * w.block_count());
+    let mut entries: Vec<Pair<usize, usize>> = Vec::with_capacity(9 * w.block_count());
+    let mut values: Vec<f64> = Vec::with_capacity(9 * w.block_count());
     for p in 0..n {
         let mu_p = mu[p].max(0.0);
         let r_star = bipotential_trial(r[p], x[p], mu_p, rho[p]);
@@ -122,16 +193,20 @@ fn newton_direction(
                     if j == p {
                         v += if a == b { 1.0 } else { 0.0 } - jp[a][b] + eta * pd[a][b];
                     }
-                    triplets.push(Triplet::new(3 * p + a, 3 * j + b, v));
+                    entries.push(Pair::new(3 * p + a, 3 * j + b));
+                    values.push(v);
                 }
             }
         }
     }
-    let jac = SparseColMat::<usize, f64>::try_new_from_triplets(3 * n, 3 * n, &triplets).ok()?;
-    let lu = jac.sp_lu().ok()?;
-    let mut rhs = faer::Mat::<f64>::from_fn(3 * n, 1, |i, _| -f[i / 3][i % 3]);
-    lu.solve_in_place(rhs.as_mut());
-    let d: Vec<f64> = (0..3 * n).map(|i| rhs[(i, 0)]).collect();
+    if pattern.is_none() {
+        *pattern = JacobianPattern::new(3 * n, &entries);
+    }
+    let jp = pattern.as_mut()?;
+    let mut d: Vec<f64> = (0..3 * n).map(|i| -f[i / 3][i % 3]).collect();
+    if !jp.solve(&values, &mut d) {
+        return None;
+    }
     d.iter().all(|v| v.is_finite()).then_some(d)
 }
 
@@ -180,6 +255,7 @@ fn newton_impl(
     let mut counts = NewtonCounts::default();
     let mut iterations = 0;
     let mut eta_rel = ETA_START;
+    let mut pattern = None;
     let mut theta = natural_map_rho(w, q, mu, &rho, &r, &mut x, &mut f);
     loop {
         let residual = natural_map_residual(&r, &x, mu);
@@ -198,7 +274,7 @@ fn newton_impl(
         iterations += 1;
         let mut accepted = false;
         let eta = eta_scale * eta_rel.min(error);
-        if let Some(d) = newton_direction(w, mu, &rho, &r, &x, &f, eta) {
+        if let Some(d) = newton_direction(w, mu, &rho, &r, &x, &f, eta, &mut pattern) {
             let mut t = 1.0;
             while t >= MIN_STEP {
                 for p in 0..n {
@@ -407,7 +483,7 @@ mod tests {
             let col: Vec<[f64; 3]> = (0..3)
                 .map(|p| std::array::from_fn(|a| (fp[p][a] - fm[p][a]) / (2.0 * h)))
                 .collect();
-            let d = newton_direction(&w, &mu, &rho, &r, &x, &col, 0.0).expect("regular");
+            let d = newton_direction(&w, &mu, &rho, &r, &x, &col, 0.0, &mut None).expect("regular");
             for (i, v) in d.iter().enumerate() {
                 let expect = if i == k { -1.0 } else { 0.0 };
                 assert!((v - expect).abs() < 1e-6, "column {k}, entry {i}: {v}");
