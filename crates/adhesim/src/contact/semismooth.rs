@@ -29,6 +29,7 @@
 //! The iteration stops on Siconos's relative error ([`super::natural_map`]), ρ = 1.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuSymbolicParams, NumericLu, SymbolicLu};
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{Argsort, Pair, SparseColMatRef, SymbolicSparseColMat};
@@ -52,6 +53,8 @@ const ETA_MIN: f64 = 1e-12;
 const ETA_MAX: f64 = 1.0;
 const ETA_DOWN: f64 = 0.1;
 const ETA_UP: f64 = 10.0;
+/// Largest Newton matrix (rows) factorised as a dense matrix rather than a sparse one.
+const DENSE_MAX: usize = 48;
 /// Smallest step length tried before a Gauss–Seidel sweep is taken instead.
 const MIN_STEP: f64 = 1.0 / (1u64 << 20) as f64;
 
@@ -152,7 +155,8 @@ impl JacobianPattern {
 }
 
 /// The Newton direction d with J d = −F at (r, x), or `None` if the factorisation fails or d
-/// is not finite. `pattern` holds the symbolic analysis of J's pattern (made on first use).
+/// is not finite. J is factorised as a dense matrix when `dense`, else as a sparse one whose
+/// symbolic analysis `pattern` holds (made on first use).
 #[allow(clippy::too_many_arguments)]
 fn newton_direction(
     w: &BlockSparseDelassus,
@@ -162,6 +166,7 @@ fn newton_direction(
     x: &[[f64; 3]],
     f: &[[f64; 3]],
     eta: f64,
+    dense: bool,
     pattern: &mut Option<JacobianPattern>,
 ) -> Option<Vec<f64>> {
     let n = w.points();
@@ -199,13 +204,22 @@ fn newton_direction(
             }
         }
     }
-    if pattern.is_none() {
-        *pattern = JacobianPattern::new(3 * n, &entries);
-    }
-    let jp = pattern.as_mut()?;
     let mut d: Vec<f64> = (0..3 * n).map(|i| -f[i / 3][i % 3]).collect();
-    if !jp.solve(&values, &mut d) {
-        return None;
+    if dense {
+        let mut jac = faer::Mat::<f64>::zeros(3 * n, 3 * n);
+        for (e, v) in entries.iter().zip(&values) {
+            jac[(e.row, e.col)] += v;
+        }
+        let mut rhs = faer::Mat::<f64>::from_fn(3 * n, 1, |i, _| d[i]);
+        jac.partial_piv_lu().solve_in_place(rhs.as_mut());
+        d.iter_mut().enumerate().for_each(|(i, v)| *v = rhs[(i, 0)]);
+    } else {
+        if pattern.is_none() {
+            *pattern = JacobianPattern::new(3 * n, &entries);
+        }
+        if !pattern.as_mut()?.solve(&values, &mut d) {
+            return None;
+        }
     }
     d.iter().all(|v| v.is_finite()).then_some(d)
 }
@@ -255,6 +269,8 @@ fn newton_impl(
     let mut counts = NewtonCounts::default();
     let mut iterations = 0;
     let mut eta_rel = ETA_START;
+    // A few contacts: a dense LU costs less than setting up the sparse one.
+    let dense = 3 * n <= DENSE_MAX;
     let mut pattern = None;
     let mut theta = natural_map_rho(w, q, mu, &rho, &r, &mut x, &mut f);
     loop {
@@ -274,7 +290,7 @@ fn newton_impl(
         iterations += 1;
         let mut accepted = false;
         let eta = eta_scale * eta_rel.min(error);
-        if let Some(d) = newton_direction(w, mu, &rho, &r, &x, &f, eta, &mut pattern) {
+        if let Some(d) = newton_direction(w, mu, &rho, &r, &x, &f, eta, dense, &mut pattern) {
             let mut t = 1.0;
             while t >= MIN_STEP {
                 for p in 0..n {
@@ -457,7 +473,8 @@ mod tests {
         assert!(sol.r.iter().any(|r| r[2] > 0.0));
     }
 
-    /// The generalised Jacobian agrees with central differences of F where F is smooth.
+    /// The generalised Jacobian agrees with central differences of F where F is smooth, through
+    /// both the dense and the sparse factorisation.
     #[test]
     fn jacobian_matches_finite_differences() {
         let (w, q) = problem(3, 7);
@@ -483,10 +500,17 @@ mod tests {
             let col: Vec<[f64; 3]> = (0..3)
                 .map(|p| std::array::from_fn(|a| (fp[p][a] - fm[p][a]) / (2.0 * h)))
                 .collect();
-            let d = newton_direction(&w, &mu, &rho, &r, &x, &col, 0.0, &mut None).expect("regular");
-            for (i, v) in d.iter().enumerate() {
-                let expect = if i == k { -1.0 } else { 0.0 };
-                assert!((v - expect).abs() < 1e-6, "column {k}, entry {i}: {v}");
+            // Both factorisations: dense (a few contacts) and sparse.
+            for dense in [true, false] {
+                let d = newton_direction(&w, &mu, &rho, &r, &x, &col, 0.0, dense, &mut None)
+                    .expect("regular");
+                for (i, v) in d.iter().enumerate() {
+                    let expect = if i == k { -1.0 } else { 0.0 };
+                    assert!(
+                        (v - expect).abs() < 1e-6,
+                        "dense {dense}, column {k}, entry {i}: {v}"
+                    );
+                }
             }
         }
     }
