@@ -124,8 +124,8 @@ mod tests {
 /// body the nodes of one line through the thickness (same reference x and y) share the
 /// unknowns of the line's first node, provided they have the same prescribed components
 /// (`fixed`, per unknown) and every contact pair that touches the body makes such a line one
-/// contact point: the plane solution has them move alike, and the system then has a third
-/// of the unknowns of the slab. Every other node is its own representative.
+/// contact point: the plane solution has them move alike, and the system of a slab one
+/// element thick then has half its free unknowns. Every other node is its own representative.
 pub fn thickness_ties(problem: &Problem, fixed: &[bool]) -> Vec<usize> {
     let offsets = problem.node_offsets();
     let mut rep: Vec<usize> = (0..fixed.len() / 3).collect();
