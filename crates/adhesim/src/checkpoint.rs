@@ -2,9 +2,10 @@
 //!
 //! A checkpoint holds the stepper's [`Snapshot`] (time, step counter, u, v, the committed
 //! contact state, the internal variables of viscoelastic materials, the current Δt and its
-//! cut-back bookkeeping, the energy accumulators, the forces at the start of the next
-//! step and the Delassus operator the Gauss-Seidel contact solve keeps for reuse), how far the outputs got (frames written, the next frame time, the PVD entries,
-//! history rows) and the run's counters. It is tied to the problem it was written for by a
+//! cut-back bookkeeping, the energy accumulators, the forces at the start of the next step
+//! and the Delassus operator the Gauss-Seidel contact solve keeps for reuse), how far the
+//! outputs got (frames written, the next frame time, the PVD entries, history rows) and the
+//! run's counters. It is tied to the problem it was written for by a
 //! fingerprint, so that resuming with a changed scenario is refused.
 //!
 //! File format (`DIR/checkpoint.bin`, little-endian): the magic `ADHCKPT\0`, a format
