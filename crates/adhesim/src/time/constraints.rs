@@ -81,45 +81,6 @@ impl Constraints {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::problem::Table;
-
-    fn clamp_x(nodes: Vec<usize>, ux: f64) -> Dirichlet {
-        Dirichlet {
-            nodes,
-            components: [true, false, false],
-            translation: [
-                Table::constant(ux),
-                Table::constant(0.0),
-                Table::constant(0.0),
-            ],
-            rotation: None,
-        }
-    }
-
-    #[test]
-    fn imposes_only_prescribed_components_and_measures_reactions_there() {
-        let c = Constraints::new(&[clamp_x(vec![1], 0.25)], 6);
-        assert_eq!(c.mask(), &[false, false, false, true, false, false]);
-        let mut u = vec![1.0; 6];
-        c.impose(&[[0.0; 3], [1.0, 0.0, 0.0]], 0.0, &mut u);
-        assert_eq!(u, vec![1.0, 1.0, 1.0, 0.25, 1.0, 1.0]);
-        let g = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
-        assert_eq!(c.reactions(&g), vec![0.0, 0.0, 0.0, 4.0, 0.0, 0.0]);
-        let mut z = g;
-        c.zero_fixed(&mut z);
-        assert_eq!(z, [1.0, 2.0, 3.0, 0.0, 5.0, 6.0]);
-        // Only the free components count: (1−0)² + (5−1)² → √17.
-        let d = c.free_distance(
-            &[1.0, 0.0, 0.0, 9.0, 5.0, 0.0],
-            &[0.0, 0.0, 0.0, 0.0, 1.0, 0.0],
-        );
-        assert!((d - 17f64.sqrt()).abs() < 1e-15);
-    }
-}
-
 /// The representative of each node (see [`crate::system::SystemMatrix`]). In a plane-strain
 /// body the nodes of one line through the thickness (same reference x and y) share the
 /// unknowns of the line's first node, provided they have the same prescribed components
@@ -160,4 +121,113 @@ pub fn thickness_ties(problem: &Problem, fixed: &[bool]) -> Vec<usize> {
         }
     }
     rep
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::problem::Table;
+
+    fn clamp_x(nodes: Vec<usize>, ux: f64) -> Dirichlet {
+        Dirichlet {
+            nodes,
+            components: [true, false, false],
+            translation: [
+                Table::constant(ux),
+                Table::constant(0.0),
+                Table::constant(0.0),
+            ],
+            rotation: None,
+        }
+    }
+
+    #[test]
+    fn imposes_only_prescribed_components_and_measures_reactions_there() {
+        let c = Constraints::new(&[clamp_x(vec![1], 0.25)], 6);
+        assert_eq!(c.mask(), &[false, false, false, true, false, false]);
+        let mut u = vec![1.0; 6];
+        c.impose(&[[0.0; 3], [1.0, 0.0, 0.0]], 0.0, &mut u);
+        assert_eq!(u, vec![1.0, 1.0, 1.0, 0.25, 1.0, 1.0]);
+        let g = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        assert_eq!(c.reactions(&g), vec![0.0, 0.0, 0.0, 4.0, 0.0, 0.0]);
+        let mut z = g;
+        c.zero_fixed(&mut z);
+        assert_eq!(z, [1.0, 2.0, 3.0, 0.0, 5.0, 6.0]);
+        // Only the free components count: (1−0)² + (5−1)² → √17.
+        let d = c.free_distance(
+            &[1.0, 0.0, 0.0, 9.0, 5.0, 0.0],
+            &[0.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+        );
+        assert!((d - 17f64.sqrt()).abs() < 1e-15);
+    }
+
+    /// A plane-strain slab (4 × 2 × 1 hexes, bottom clamped) with `contact`: its problem and
+    /// the representatives of its nodes.
+    fn slab_ties(contact: &str) -> (crate::problem::Problem, Vec<usize>) {
+        let text = format!(
+            r#"
+[time]
+t_end = 1.0
+dt = 0.1
+
+[[body]]
+name = "slab"
+mesh = {{ generator = "block", size = [0.004, 0.001, 0.0005], divisions = [4, 2, 1] }}
+material = {{ model = "blatz-ko", g = 1e6 }}
+density = 1000.0
+plane_strain = true
+
+[[boundary]]
+body = "slab"
+set = "bottom"
+fix = ["x", "y", "z"]
+{contact}
+"#
+        );
+        let problem = crate::scenario::parse(&text, std::path::Path::new("ties.toml")).unwrap();
+        let n: usize = problem.bodies.iter().map(|b| b.mesh.num_nodes()).sum();
+        let fixed = Constraints::new(&problem.dirichlet, 3 * n);
+        let rep = thickness_ties(&problem, fixed.mask());
+        (problem, rep)
+    }
+
+    /// Against a rigid surface every line of the slab is tied to its node at the smaller
+    /// index, at the same x and y; a 3D body pressing the slab leaves it node by node.
+    #[test]
+    fn plane_strain_lines_are_tied_unless_a_3d_body_touches_the_slab() {
+        let rigid = r#"
+[[contact]]
+name = "plate"
+slave = { body = "slab", set = "top" }
+master = { rigid = "plane", point = [0.0, 0.0012, 0.0], normal = [0.0, -1.0, 0.0] }
+friction = 0.3
+"#;
+        let (problem, rep) = slab_ties(rigid);
+        let nodes = &problem.bodies[0].mesh.nodes;
+        assert_eq!(rep.len(), nodes.len());
+        let tied: Vec<usize> = (0..rep.len()).filter(|&n| rep[n] != n).collect();
+        // 5 × 3 lines of two nodes: one of each pair is tied.
+        assert_eq!(tied.len(), 15);
+        for &n in &tied {
+            let (a, b) = (nodes[n], nodes[rep[n]]);
+            assert!(rep[n] < n && rep[rep[n]] == rep[n]);
+            assert!(a[0] == b[0] && a[1] == b[1] && a[2] != b[2], "{a:?} {b:?}");
+        }
+        let block = r#"
+[[body]]
+name = "block"
+mesh = { generator = "block", size = [0.002, 0.001, 0.0005], divisions = [2, 1, 1] }
+offset = [0.001, 0.0011, 0.0]
+material = { model = "blatz-ko", g = 1e6 }
+density = 1000.0
+
+[[contact]]
+name = "press"
+slave = { body = "block", set = "bottom" }
+master = { body = "slab", set = "top" }
+friction = 0.3
+"#;
+        let (_, rep) = slab_ties(block);
+        assert!((0..rep.len()).all(|n| rep[n] == n), "no ties: {rep:?}");
+    }
 }
