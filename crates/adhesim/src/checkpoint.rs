@@ -5,15 +5,14 @@
 //! cut-back bookkeeping, the energy accumulators, the forces at the start of the next step
 //! and the Delassus operator the Gauss-Seidel contact solve keeps for reuse), how far the
 //! outputs got (frames written, the next frame time, the PVD entries, history rows) and the
-//! run's counters. It is tied to the problem it was written for by a
-//! fingerprint, so that resuming with a changed scenario is refused.
+//! run's counters. It is tied to the problem it was written for by a fingerprint, so that
+//! resuming with a changed scenario is refused.
 //!
 //! File format (`DIR/checkpoint.bin`, little-endian): the magic `ADHCKPT\0`, a format
 //! version (u32), then length-prefixed fields (u64 counts, f64 bit patterns, UTF-8 strings),
 //! and last an FNV-1a 64 checksum of everything before it. The file is replaced atomically
 //! (see [`crate::output::atomic`]), so there is always one complete checkpoint: the last.
 
-use crate::contact::solve::Delassus;
 use crate::output::FrameProgress;
 use crate::problem::Problem;
 use crate::time::{CachedDelassus, DelassusCache, NodeContact, Snapshot};
@@ -276,23 +275,17 @@ impl Checkpoint {
 
 /// The kept Delassus operator: a count (0 or 1), then its key, its frames and W.
 fn delassus(c: &mut impl Codec, cache: &mut DelassusCache) -> Result<(), String> {
-    let mut present: Vec<()> = cache.iter().map(|_| ()).collect();
-    c.count(&mut present, 24)?;
-    if present.len() > 1 {
-        return Err("more than one Delassus operator".into());
+    let mut present = usize::from(cache.is_some());
+    c.usize(&mut present)?;
+    match present {
+        0 => {
+            *cache = None;
+            return Ok(());
+        }
+        1 => {}
+        _ => return Err("more than one Delassus operator".into()),
     }
-    if present.is_empty() {
-        *cache = None;
-        return Ok(());
-    }
-    let d = cache.get_or_insert_with(|| CachedDelassus {
-        key: Vec::new(),
-        frames: Vec::new(),
-        w: Delassus {
-            w: Vec::new(),
-            m: 0,
-        },
-    });
+    let d = cache.get_or_insert_with(CachedDelassus::default);
     c.count(&mut d.key, 8)?;
     d.key.iter_mut().try_for_each(|k| c.u64(k))?;
     c.count(&mut d.frames, 72)?;
@@ -454,7 +447,7 @@ mod tests {
                 delassus: Some(CachedDelassus {
                     key: vec![7, u64::MAX],
                     frames: vec![[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -0.5]]],
-                    w: Delassus {
+                    w: crate::contact::solve::Delassus {
                         w: (0..9).map(|i| i as f64 * 1e-7).collect(),
                         m: 3,
                     },

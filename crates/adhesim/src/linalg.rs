@@ -140,7 +140,8 @@ impl BlockPattern {
                 for k in 0..3 {
                     let rows = if a == b { k + 1 } else { 3 };
                     for i in 0..rows {
-                        map[self.position(r, b, i, k)] = out.entry(3 * rep[a] + i, 3 * rep[b] + k);
+                        let to = out.scalar_position(3 * rep[a] + i, 3 * rep[b] + k);
+                        map[self.position(r, b, i, k)] = (to, 1.0);
                     }
                 }
                 if a != b && rep[a] == rep[b] {
@@ -153,12 +154,14 @@ impl BlockPattern {
         (out, map)
     }
 
-    /// Position and factor 1 of scalar entry (i, j) or (j, i), whichever is stored.
-    fn entry(&self, i: usize, j: usize) -> (usize, f64) {
+    /// Index into the value array of scalar entry (i, j) or (j, i), whichever is stored; the
+    /// pattern must hold the nodes' block.
+    pub fn scalar_position(&self, i: usize, j: usize) -> usize {
         let (i, j) = (i.min(j), i.max(j));
-        let (a, b) = (i / 3, j / 3);
-        let rank = self.rank(a, b).expect("the pattern holds the block");
-        (self.position(rank, b, i % 3, j % 3), 1.0)
+        let rank = self
+            .rank(i / 3, j / 3)
+            .expect("the pattern holds the block");
+        self.position(rank, j / 3, i % 3, j % 3)
     }
 
     /// Number of stored values.

@@ -111,7 +111,7 @@ impl SystemMatrix {
         for (q, &(slot, factor)) in self.base_to_tied.iter().enumerate() {
             let slot = ext.map_or(slot, |map| map[slot]);
             let v: f64 = terms.iter().map(|(c, a)| c * a[q]).sum();
-            self.values[slot] += if factor == 1.0 { v } else { factor * v };
+            self.values[slot] += factor * v;
         }
     }
 
@@ -121,13 +121,7 @@ impl SystemMatrix {
     pub fn add_block(&mut self, a: usize, b: usize, block: &[[f64; 3]; 3]) {
         let (ra, rb) = (self.rep[a], self.rep[b]);
         let p = &self.pattern;
-        let mut add = |i: usize, j: usize, v: f64| {
-            let (i, j) = (i.min(j), i.max(j));
-            let rank = p
-                .rank(i / 3, j / 3)
-                .expect("the pattern holds the contact couplings");
-            self.values[p.position(rank, j / 3, i % 3, j % 3)] += v;
-        };
+        let mut add = |i: usize, j: usize, v: f64| self.values[p.scalar_position(i, j)] += v;
         if ra == rb {
             // K_aa, or K_ab + K_ba on the representative's diagonal block.
             for i in 0..3 {
@@ -267,30 +261,6 @@ mod tests {
         assert_eq!(b[0], 0.0);
     }
 
-    /// Dense solve of a small system by Gaussian elimination with partial pivoting.
-    fn dense_solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
-        let n = b.len();
-        for c in 0..n {
-            let p = (c..n)
-                .max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))
-                .unwrap();
-            a.swap(c, p);
-            b.swap(c, p);
-            for r in c + 1..n {
-                let f = a[r][c] / a[c][c];
-                for k in c..n {
-                    a[r][k] -= f * a[c][k];
-                }
-                b[r] -= f * b[c];
-            }
-        }
-        let mut x = vec![0.0; n];
-        for r in (0..n).rev() {
-            x[r] = (b[r] - (r + 1..n).map(|k| a[r][k] * x[k]).sum::<f64>()) / a[r][r];
-        }
-        x
-    }
-
     /// Nodes 2 and 3 tied to nodes 0 and 1, z held everywhere (a plane-strain slab of one
     /// element): the solve equals the dense solve of Tᵀ K T y = Tᵀ b with x = T y, to
     /// round-off, with an element matrix and a contact block between tied nodes added.
@@ -348,17 +318,17 @@ mod tests {
         // node 1) to all four nodes.
         let free = [0usize, 1, 3, 4];
         let t = |d: usize| d % 6; // the representative unknown of unknown d
-        let mut kc = vec![vec![0.0; 4]; 4];
-        let mut bc = vec![0.0; 4];
+        let mut kc = nalgebra::DMatrix::<f64>::zeros(4, 4);
+        let mut bc = nalgebra::DVector::<f64>::zeros(4);
         for i in (0..12).filter(|d| d % 3 != 2) {
             let ri = free.iter().position(|&f| f == t(i)).unwrap();
             bc[ri] += b[i];
             for j in (0..12).filter(|d| d % 3 != 2) {
                 let rj = free.iter().position(|&f| f == t(j)).unwrap();
-                kc[ri][rj] += k[i][j];
+                kc[(ri, rj)] += k[i][j];
             }
         }
-        let y = dense_solve(kc, bc);
+        let y = kc.lu().solve(&bc).expect("regular");
         for d in 0..12 {
             let expected = if d % 3 == 2 {
                 0.0

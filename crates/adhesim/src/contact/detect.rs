@@ -467,11 +467,7 @@ pub fn rigid_projection(shape: &RigidShape, x: [f64; 3]) -> ([f64; 3], [f64; 3],
         RigidShape::Sphere { center, radius } => {
             let d = Vec3::from(x) - Vec3::from(*center);
             let r = d.norm();
-            let n: [f64; 3] = if r > 0.0 {
-                (d / r).into()
-            } else {
-                [0.0, 1.0, 0.0]
-            };
+            let n: [f64; 3] = unit(d).into();
             (
                 std::array::from_fn(|k| center[k] + radius * n[k]),
                 n,
@@ -487,11 +483,7 @@ pub fn rigid_projection(shape: &RigidShape, x: [f64; 3]) -> ([f64; 3], [f64; 3],
             let along = d.dot(&Vec3::from(*axis));
             let radial = d - along * Vec3::from(*axis);
             let r = radial.norm();
-            let n: [f64; 3] = if r > 0.0 {
-                (radial / r).into()
-            } else {
-                [0.0, 1.0, 0.0]
-            };
+            let n: [f64; 3] = unit(radial).into();
             (
                 std::array::from_fn(|k| point[k] + along * axis[k] + radius * n[k]),
                 n,

@@ -32,7 +32,7 @@ use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuSymbolicParams, NumericLu, SymbolicLu};
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::{Argsort, Pair, SparseColMatRef, SymbolicSparseColMat};
+use faer::sparse::{Argsort, Pair, SparseColMat, SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Spec};
 
 use super::law::{bipotential_trial, dry_projection, projection_jacobian};
@@ -126,13 +126,10 @@ impl JacobianPattern {
     /// Solves J d = `rhs` in place for J with `entries_values` listed in the analysed order;
     /// false if the factorisation fails.
     fn solve(&mut self, entries_values: &[f64], rhs: &mut [f64]) -> bool {
-        let jac = match faer::sparse::SparseColMat::new_from_argsort(
-            self.symbolic.clone(),
-            &self.order,
-            entries_values,
-        ) {
-            Ok(m) => m,
-            Err(_) => return false,
+        let Ok(jac) =
+            SparseColMat::new_from_argsort(self.symbolic.clone(), &self.order, entries_values)
+        else {
+            return false;
         };
         let a: SparseColMatRef<'_, usize, f64> = jac.as_ref();
         let stack = MemStack::new(&mut self.mem);
@@ -210,9 +207,8 @@ fn newton_direction(
         for (e, v) in entries.iter().zip(&values) {
             jac[(e.row, e.col)] += v;
         }
-        let mut rhs = faer::Mat::<f64>::from_fn(3 * n, 1, |i, _| d[i]);
-        jac.partial_piv_lu().solve_in_place(rhs.as_mut());
-        d.iter_mut().enumerate().for_each(|(i, v)| *v = rhs[(i, 0)]);
+        jac.partial_piv_lu()
+            .solve_in_place(MatMut::from_column_major_slice_mut(&mut d, 3 * n, 1));
     } else {
         if pattern.is_none() {
             *pattern = JacobianPattern::new(3 * n, &entries);

@@ -8,7 +8,7 @@ use crate::linalg::LinearSolve;
 use crate::Mat3;
 
 /// The dense Delassus operator W = H K̄⁻¹ Hᵀ of the contact points.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Delassus {
     /// W, 3N_c × 3N_c, row-major [m/N].
     pub w: Vec<f64>,
@@ -266,24 +266,25 @@ pub fn gauss_seidel(
 mod tests {
     use super::*;
     use crate::contact::detect::frame_from_normal as unit_frame;
+    use crate::Vec3;
 
+    /// The frame of the (not necessarily unit) normal `n`.
     fn frame_from_normal(n: [f64; 3]) -> [[f64; 3]; 3] {
-        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        unit_frame(n.map(|c| c / len))
+        unit_frame(Vec3::from(n).normalize().into())
     }
 
     /// W in local frames from W^g in global axes: W_αβ = F_α W^g_αβ F_βᵀ.
     fn local(wg: &[f64], frames: &[[[f64; 3]; 3]]) -> Delassus {
         let m = 3 * frames.len();
+        let mat = |f: &[[f64; 3]; 3]| Mat3::from_fn(|i, j| f[i][j]);
         let mut w = vec![0.0; m * m];
         for (a, fa) in frames.iter().enumerate() {
             for (b, fb) in frames.iter().enumerate() {
+                let at = |i: usize, j: usize| (3 * a + i) * m + 3 * b + j;
+                let block = mat(fa) * Mat3::from_fn(|i, j| wg[at(i, j)]) * mat(fb).transpose();
                 for i in 0..3 {
                     for j in 0..3 {
-                        w[(3 * a + i) * m + 3 * b + j] = (0..3)
-                            .flat_map(|k| (0..3).map(move |l| (k, l)))
-                            .map(|(k, l)| fa[i][k] * wg[(3 * a + k) * m + 3 * b + l] * fb[j][l])
-                            .sum();
+                        w[at(i, j)] = block[(i, j)];
                     }
                 }
             }

@@ -30,7 +30,7 @@ const MAX_SWEEPS: usize = 5000;
 
 /// The last Delassus operator, kept between steps (and in checkpoints, so that a resumed
 /// run reuses it exactly as the uninterrupted run would).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct CachedDelassus {
     /// What it was built for besides the frames and K̄ (see [`delassus_key`]).
     pub key: Vec<u64>,
@@ -97,7 +97,7 @@ impl<'a> DelassusCoupling<'a> {
             // Same points: turn W to this step's frames (exact while K̄ and the master
             // weights are unchanged); the probe below judges what else changed.
             let cached = self.cache.as_mut().expect("matched above");
-            let frames: Vec<_> = self.sc.points.iter().map(|p| p.frame).collect();
+            let frames = frames_of(&self.sc.points);
             if cached.frames != frames {
                 cached.w.rotate_frames(&cached.frames, &frames);
                 cached.frames = frames;
@@ -125,7 +125,7 @@ impl<'a> DelassusCoupling<'a> {
             let del = delassus(&self.sc.points, system, mask);
             *self.cache = Some(CachedDelassus {
                 key: self.key.clone(),
-                frames: self.sc.points.iter().map(|p| p.frame).collect(),
+                frames: frames_of(&self.sc.points),
                 w: del,
             });
             self.builds += 1;
@@ -248,6 +248,11 @@ impl<'a> ContactCoupling<'a> for DelassusCoupling<'a> {
     fn abandon(&mut self) {
         *self.cache = None;
     }
+}
+
+/// The local frame of each point, the frames W is expressed in.
+fn frames_of(points: &[ContactPoint]) -> Vec<[[f64; 3]; 3]> {
+    points.iter().map(|p| p.frame).collect()
 }
 
 /// What a cached W must share with this step to be reused: the contact points (pair, slave
