@@ -25,6 +25,7 @@ pub mod problem;
 pub mod run;
 pub mod scenario;
 pub mod slurm;
+pub mod sparse_lu;
 pub mod sweep;
 pub mod system;
 pub mod time;

@@ -61,7 +61,7 @@ impl BlockPattern {
     }
 
     /// The pattern of sorted upper neighbour lists (each node's list ends with itself).
-    fn from_neighbours(num_nodes: usize, nbrs: Vec<Vec<usize>>) -> Self {
+    pub fn from_neighbours(num_nodes: usize, nbrs: Vec<Vec<usize>>) -> Self {
         let n = 3 * num_nodes;
         let mut col_ptr = Vec::with_capacity(n + 1);
         let mut row_idx = Vec::new();

@@ -101,6 +101,9 @@ pub enum ContactSolver {
     /// The contact law inside the step's Newton loop, its generalised Jacobian in the sparse
     /// matrix, with augmented-Lagrangian multiplier updates: no Delassus operator.
     Newton,
+    /// Semismooth Newton on the contact forces with directions from sparse LU factorisations
+    /// of the mixed (displacement, force) matrix: no Delassus operator.
+    Semismooth,
     /// The reduced system on the dense Delassus operator W = H K̄⁻¹ Hᵀ, solved by nonlinear
     /// Gauss-Seidel over contact points (small problems, cross-checks).
     #[default]

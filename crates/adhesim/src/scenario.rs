@@ -910,9 +910,10 @@ fn validate_time(t: &FileTime, ctx: &Ctx) -> Result<TimeSettings, ScenarioError>
         None => d.contact_solver,
         Some("newton") => ContactSolver::Newton,
         Some("gauss-seidel") => ContactSolver::GaussSeidel,
+        Some("semismooth") => ContactSolver::Semismooth,
         Some(m) => {
             return Err(ctx.err(format!(
-                "`time.contact_solver` = {m:?}; valid values are \"newton\" and \"gauss-seidel\""
+                "`time.contact_solver` = {m:?}; valid values are \"semismooth\", \"newton\" and \"gauss-seidel\""
             )))
         }
     };

@@ -160,6 +160,32 @@ impl SystemMatrix {
         self.chol.factorise(&self.values)
     }
 
+    /// The matrix last factorised: its pattern (upper triangle) and values, with the
+    /// Dirichlet conditions and the ties applied.
+    pub fn factorised_matrix(&self) -> (&BlockPattern, &[f64]) {
+        (&self.pattern, &self.values)
+    }
+
+    /// The representative node of each node.
+    pub fn representatives(&self) -> &[usize] {
+        &self.rep
+    }
+
+    /// Whether each scalar unknown has a zero row and column with a positive diagonal in the
+    /// factorised matrix (prescribed, or of a tied node).
+    pub fn fixed(&self) -> &[bool] {
+        &self.fixed
+    }
+
+    /// Copies the unknowns of each representative to the nodes tied to it.
+    pub fn expand_tied(&self, v: &mut [f64]) {
+        for &(t, r) in &self.tied_nodes {
+            for k in 0..3 {
+                v[3 * t + k] = v[3 * r + k];
+            }
+        }
+    }
+
     /// Solves K̄ x = b in place, for one or more right-hand sides (column-major).
     pub fn solve_in_place(&mut self, rhs: &mut [f64]) {
         let (n, tied) = (self.fixed.len(), &self.tied_nodes);

@@ -12,6 +12,7 @@ mod constraints;
 mod coupling;
 mod delassus_coupling;
 mod integrator;
+mod mixed_coupling;
 mod newton_coupling;
 mod newton_loop;
 
@@ -21,6 +22,7 @@ pub use constraints::Constraints;
 use crate::assembly::{BadElement, Discretisation};
 use crate::contact::detect::{align_frames, detect, ContactPoint};
 use crate::contact::law::{accumulated_damage, BondState, ContactState, PointSolution};
+use crate::contact::mixed::MixedWorkspace;
 use crate::linalg::LinalgError;
 use crate::problem::{ContactSolver, Problem};
 use crate::system::SystemMatrix;
@@ -29,6 +31,7 @@ use coupling::{Candidates, ContactCoupling, StepContact};
 use delassus_coupling::DelassusCoupling;
 pub use delassus_coupling::{CachedDelassus, DelassusCache};
 use integrator::{Inertia, Scheme, ThetaStep, Workspace};
+use mixed_coupling::MixedCoupling;
 use newton_coupling::NewtonCoupling;
 use newton_loop::{Flow, NewtonLoop};
 use std::sync::Arc;
@@ -264,6 +267,8 @@ pub struct Stepper {
     model_size: f64,
     /// The last Delassus operator, kept for reuse by the Gauss-Seidel contact solve.
     delassus_cache: DelassusCache,
+    /// The semismooth solve's LU analysis, kept while the mixed matrix's pattern stays.
+    mixed_workspace: MixedWorkspace,
     /// Nodal reaction forces of the last committed step [N] (see [`Stepper::reactions`]).
     reactions: Vec<f64>,
     /// Buffers of the Newton loop.
@@ -319,6 +324,7 @@ impl Stepper {
             contact: Vec::new(),
             model_size: 0.0,
             delassus_cache: None,
+            mixed_workspace: MixedWorkspace::default(),
             reactions: vec![0.0; n],
             workspace: Workspace::default(),
         };
@@ -646,9 +652,12 @@ impl Stepper {
         let (contact, lambda) =
             StepContact::new(candidates, laws, dt, reference, &self.constraints);
         let system = &mut self.system;
-        let coupling: Box<dyn ContactCoupling<'_> + '_> = match lambda {
-            Some(lambda) => Box::new(NewtonCoupling::new(contact, lambda, system)?),
-            None => Box::new(DelassusCoupling::new(contact, &mut self.delassus_cache)),
+        let coupling: Box<dyn ContactCoupling<'_> + '_> = match (settings.contact_solver, lambda) {
+            (ContactSolver::Semismooth, Some(r0)) => {
+                Box::new(MixedCoupling::new(contact, r0, &mut self.mixed_workspace))
+            }
+            (_, Some(lambda)) => Box::new(NewtonCoupling::new(contact, lambda, system)?),
+            (_, None) => Box::new(DelassusCoupling::new(contact, &mut self.delassus_cache)),
         };
         let detect_time = clock.elapsed().as_secs_f64();
         let step = ThetaStep::new(
@@ -709,7 +718,7 @@ impl Stepper {
             .sum::<f64>()
             .sqrt();
         Candidates {
-            multipliers: (self.problem.time.contact_solver == ContactSolver::Newton)
+            multipliers: (self.problem.time.contact_solver != ContactSolver::GaussSeidel)
                 .then(|| self.multipliers_at_start(&points)),
             bond0: self.bonds_at_start(&points),
             points,

@@ -9,6 +9,7 @@
 pub mod anisotropic;
 pub mod detect;
 pub mod law;
+pub mod mixed;
 pub mod natural_map;
 pub mod newton;
 pub mod reduced;

@@ -1,0 +1,620 @@
+//! The contact problem of a Newton iteration solved without the Delassus operator: a
+//! semismooth Newton method on the contact forces whose directions come from one sparse LU
+//! factorisation of the mixed system in (displacement, force) (docs/contact-solver.md).
+//!
+//! Within a Newton iteration of the step, K̄ is fixed and the local relative displacements are
+//! affine in the contact forces r (total, local frames):
+//!
+//!   K̄ δu = Hᵀ (r − r₀),   x = x₀ + H δu   (so x = x₀ + W (r − r₀), W = H K̄⁻¹ Hᵀ never formed),
+//!
+//! and each point's law is written as the bi-potential natural map of its dry part
+//! y = r − r̃(x) (r̃ the RCC adhesive force, smooth given β₁(x)):
+//!
+//!   Φ_α(r_α, x_α) = y − P_K(y − ρ_α (x + μ‖x_t‖n)) = 0.
+//!
+//! A generalised Jacobian of Φ_α is dΦ = A_α dr + B_α dx with A = I − P' and
+//! B = A k̃ + ρ P' D ([`linearise_point`]). The semismooth Newton direction d of the reduced
+//! problem, (A + B W) d = −Φ, is the force part of the solution of
+//!
+//!   ⎡ K̄    −Hᵀ  ⎤ ⎡ δu ⎤   ⎡ 0 ⎤
+//!   ⎣ B H   A + ηB⎦ ⎣ d  ⎦ = ⎣ −Φ⎦,
+//!
+//! whose δu part gives x's change along d, H δu = W d, so that the line search on
+//! θ = ½‖Φ‖² evaluates trial points without any further solve. The matrix has the size of the
+//! unknowns plus three rows per contact point and the sparsity of K̄ and H: memory and cost grow
+//! like one factorisation of K̄, not like the square of the number of contacts. ηB is the
+//! proximal regularisation of [`super::semismooth`] (x + η r in place of x), which keeps the
+//! matrix regular when sticking points are more than the unknowns can satisfy, and vanishes as
+//! the residual does.
+
+use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
+
+use super::anisotropic::{scale, unscale};
+use super::law::{
+    adhesive_response, bipotential_trial, dry_projection, projection_jacobian, BondState,
+    InterfaceLaw, PointSolution,
+};
+use crate::linalg::{metis_dof_ordering, BlockPattern};
+use crate::sparse_lu::OrderedLu;
+use crate::Mat3;
+
+type V3 = [f64; 3];
+
+/// Armijo constant σ of the line search on θ = ½‖Φ‖².
+const ARMIJO: f64 = 1e-4;
+/// Shortest step length the line search tries.
+const MIN_STEP: f64 = 1.0 / 1024.0;
+/// Proximal regularisation η relative to 1/ρ: its start, bounds and the factors applied after
+/// a full step and after a shortened or failed one (as in [`super::semismooth`]).
+const ETA_START: f64 = 1e-2;
+const ETA_MIN: f64 = 1e-12;
+const ETA_MAX: f64 = 1.0;
+const ETA_DOWN: f64 = 0.1;
+const ETA_UP: f64 = 10.0;
+
+/// The natural map of one point linearised at (r, x).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointLinearisation {
+    /// Φ = y − P_K(y − ρ x̂) [N] with y = r − r̃(x).
+    pub phi: V3,
+    /// ∂Φ/∂r [-].
+    pub a: Mat3,
+    /// ∂Φ/∂x [N/m] (with the adhesive stiffness at fixed β₁).
+    pub b: Mat3,
+    /// The point's forces, β₁, bond stretch and case at (r, x).
+    pub solution: PointSolution,
+}
+
+/// [`PointLinearisation`] of the law `law` at total force `r` [N] and local relative
+/// displacement `x` [m], for a point with committed bond `bond0`, step `dt` [s], tributary
+/// area `area` [m²] and natural-map parameter `rho` [N/m]. An orthotropic law is linearised in
+/// its scaled variables (y' = T⁻¹y, x' = Tx) and mapped back: Φ = TΦ', A = T A' T⁻¹,
+/// B_dry = T B' T.
+pub fn linearise_point(
+    law: &InterfaceLaw,
+    bond0: BondState,
+    dt: f64,
+    area: f64,
+    rho: f64,
+    r: V3,
+    x: V3,
+) -> PointLinearisation {
+    let mu = law.mu.max(0.0);
+    let (r_adh, k_adh, beta, ut) = match &law.adhesion {
+        Some(a) => {
+            let resp = adhesive_response(a, bond0, dt, area, x);
+            let k = Mat3::from_fn(|i, j| resp.secant_stiffness[i][j]);
+            (resp.force, k, resp.beta, resp.ut)
+        }
+        None => ([0.0; 3], Mat3::zeros(), 0.0, [0.0; 2]),
+    };
+    let y: V3 = std::array::from_fn(|k| r[k] - r_adh[k]);
+    let s = law.tangent_scale();
+    let (ys, xs) = (unscale(y, s), scale(x, s));
+    let r_star = bipotential_trial(ys, xs, mu, rho);
+    let (proj, state) = dry_projection(r_star, mu);
+    let pj = projection_jacobian(r_star, mu, state);
+    let pj = Mat3::from_fn(|i, j| pj[i][j]);
+    // D = ∂(x + μ‖x_t‖n)/∂x = I + μ n (x_t/‖x_t‖, 0)ᵀ, the second term dropped at x_t = 0.
+    let mut d = Mat3::identity();
+    let st = xs[0].hypot(xs[1]);
+    if st > 0.0 && mu > 0.0 {
+        d[(2, 0)] = mu * xs[0] / st;
+        d[(2, 1)] = mu * xs[1] / st;
+    }
+    let t = Mat3::from_diagonal(&scale([1.0; 3], s).into());
+    let t_inv = Mat3::from_diagonal(&unscale([1.0; 3], s).into());
+    let a = t * (Mat3::identity() - pj) * t_inv;
+    let b = a * k_adh + t * (rho * pj * d) * t;
+    let phi = scale(std::array::from_fn(|k| ys[k] - proj[k]), s);
+    PointLinearisation {
+        phi,
+        a,
+        b,
+        solution: PointSolution {
+            r_dry: y,
+            r_adh,
+            x,
+            beta,
+            ut,
+            state,
+            iterations: 1,
+            converged: true,
+        },
+    }
+}
+
+/// K̄ (symmetric, upper triangle in compressed columns) and H of the mixed system.
+pub struct MixedOperator<'a> {
+    /// Column pointers of K̄'s upper triangle (n + 1).
+    pub col_ptr: &'a [usize],
+    /// Row indices of K̄'s upper triangle.
+    pub row_idx: &'a [usize],
+    /// Values of K̄'s upper triangle [N/m].
+    pub values: &'a [f64],
+    /// H of each point: the unknowns it reads with the coefficients of its three local
+    /// components (x_α = Σ h u_i), each unknown listed once.
+    pub h: &'a [Vec<(usize, V3)>],
+}
+
+impl MixedOperator<'_> {
+    fn n(&self) -> usize {
+        self.col_ptr.len() - 1
+    }
+
+    /// H_α v for point `p`.
+    pub fn apply_h(&self, p: usize, v: &[f64]) -> V3 {
+        let mut out = [0.0; 3];
+        for &(i, c) in &self.h[p] {
+            for k in 0..3 {
+                out[k] += c[k] * v[i];
+            }
+        }
+        out
+    }
+
+    /// The mixed matrix's entries in a fixed order (K̄, then point by point −Hᵀ, B H and
+    /// A + ηB), with their values for the linearisations `lin` and regularisation `eta` [m/N].
+    fn entries(&self, lin: &[PointLinearisation], eta: f64) -> (Vec<Pair<usize, usize>>, Vec<f64>) {
+        let n = self.n();
+        let h_count: usize = self.h.iter().map(|h| h.len()).sum();
+        let cap = 2 * self.values.len() + 6 * h_count + 9 * self.h.len();
+        let mut entries = Vec::with_capacity(cap);
+        let mut values = Vec::with_capacity(cap);
+        for j in 0..n {
+            for q in self.col_ptr[j]..self.col_ptr[j + 1] {
+                let i = self.row_idx[q];
+                entries.push(Pair::new(i, j));
+                values.push(self.values[q]);
+                if i != j {
+                    entries.push(Pair::new(j, i));
+                    values.push(self.values[q]);
+                }
+            }
+        }
+        for (p, (h, l)) in self.h.iter().zip(lin).enumerate() {
+            let row = n + 3 * p;
+            for &(i, c) in h {
+                let bh = l.b * nalgebra::Vector3::from(c);
+                for k in 0..3 {
+                    entries.push(Pair::new(i, row + k));
+                    values.push(-c[k]);
+                    entries.push(Pair::new(row + k, i));
+                    values.push(bh[k]);
+                }
+            }
+            let diag = l.a + eta * l.b;
+            for a in 0..3 {
+                for b in 0..3 {
+                    entries.push(Pair::new(row + a, row + b));
+                    values.push(diag[(a, b)]);
+                }
+            }
+        }
+        (entries, values)
+    }
+}
+
+/// The mixed matrix's pattern, the order its entries are listed in and its LU analysis
+/// (columns in METIS nested-dissection order of the node graph, each contact point a node
+/// joined to the nodes it reads), made once and reused while the pattern stays.
+pub struct MixedPattern {
+    entries: Vec<Pair<usize, usize>>,
+    symbolic: SymbolicSparseColMat<usize>,
+    order: Argsort<usize>,
+    lu: OrderedLu,
+}
+
+impl MixedPattern {
+    fn new(op: &MixedOperator, entries: Vec<Pair<usize, usize>>) -> Result<Self, String> {
+        let fail = |e: &dyn std::fmt::Debug| format!("mixed contact matrix analysis: {e:?}");
+        let (n, m) = (op.n(), op.h.len());
+        let dim = n + 3 * m;
+        let (symbolic, order) =
+            SymbolicSparseColMat::try_new_from_indices(dim, dim, &entries).map_err(|e| fail(&e))?;
+        let nodes = n / 3;
+        let mut nbrs: Vec<Vec<usize>> = vec![Vec::new(); nodes + m];
+        for j in 0..n {
+            for &i in &op.row_idx[op.col_ptr[j]..op.col_ptr[j + 1]] {
+                nbrs[j / 3].push(i / 3);
+            }
+        }
+        for (p, h) in op.h.iter().enumerate() {
+            nbrs[nodes + p].extend(h.iter().map(|&(i, _)| i / 3));
+        }
+        for (b, list) in nbrs.iter_mut().enumerate() {
+            list.push(b);
+            list.sort_unstable();
+            list.dedup();
+        }
+        let graph = BlockPattern::from_neighbours(nodes + m, nbrs);
+        let (fwd, inv) = metis_dof_ordering(&graph).map_err(|e| fail(&e))?;
+        let lu = OrderedLu::analyse(
+            symbolic.col_ptr().to_vec(),
+            symbolic.row_idx().to_vec(),
+            fwd,
+            inv,
+        )
+        .map_err(|e| fail(&e))?;
+        Ok(MixedPattern {
+            entries,
+            symbolic,
+            order,
+            lu,
+        })
+    }
+
+    /// Solves the matrix with `values` (in the analysed order) against `rhs` in place; false
+    /// if the factorisation fails or the solution is not finite.
+    fn solve(&mut self, values: &[f64], rhs: &mut [f64]) -> bool {
+        let Ok(mat) = SparseColMat::new_from_argsort(self.symbolic.clone(), &self.order, values)
+        else {
+            return false;
+        };
+        if self.lu.factorise(mat.val()).is_err() {
+            return false;
+        }
+        self.lu.solve_in_place(rhs);
+        rhs.iter().all(|v| v.is_finite())
+    }
+}
+
+/// What [`solve_mixed`] keeps between calls: the LU analysis (redone when the entries
+/// differ) and the regularisation's current level.
+pub struct MixedWorkspace {
+    pattern: Option<MixedPattern>,
+    eta_rel: f64,
+}
+
+impl Default for MixedWorkspace {
+    fn default() -> Self {
+        MixedWorkspace {
+            pattern: None,
+            eta_rel: ETA_START,
+        }
+    }
+}
+
+impl MixedWorkspace {
+    /// Resets the regularisation to its starting level (at the start of a step, so that a
+    /// step's iterates depend only on the step's data and a resumed run repeats them).
+    pub fn start_step(&mut self) {
+        self.eta_rel = ETA_START;
+    }
+}
+
+/// What [`solve_mixed`] found.
+#[derive(Clone, Debug)]
+pub struct MixedSolution {
+    /// Total contact force of each point (local frame) [N].
+    pub r: Vec<V3>,
+    /// Each point's law at the solution.
+    pub points: Vec<PointSolution>,
+    /// Change of the unknowns δu = K̄⁻¹Hᵀ(r − r₀) [m].
+    pub du: Vec<f64>,
+    /// The caller's measure of the residual at the end [N].
+    pub residual: f64,
+    /// Newton steps taken (each one LU factorisation).
+    pub iterations: usize,
+    /// Whether the measure is ≤ the tolerance.
+    pub converged: bool,
+}
+
+/// Semismooth Newton on the contact forces from `r0` (where the local displacements are `x0`
+/// [m]) until `measure` of the points' solutions is ≤ `tol` [N] or `max_iter` steps;
+/// `law(p, r, x)` linearises point p's law with its natural-map parameter `rho[p]` [N/m].
+/// `measure` is the caller's residual (e.g. the natural map with another ρ; Φ's norm with
+/// these ρ is the merit of the line search). `ws` carries the LU analysis and the
+/// regularisation level from call to call.
+#[allow(clippy::too_many_arguments)]
+pub fn solve_mixed(
+    op: &MixedOperator,
+    law: impl Fn(usize, V3, V3) -> PointLinearisation,
+    measure: impl Fn(&[PointSolution]) -> f64,
+    rho: &[f64],
+    r0: &[V3],
+    x0: &[V3],
+    tol: f64,
+    max_iter: usize,
+    ws: &mut MixedWorkspace,
+) -> Result<MixedSolution, String> {
+    let MixedWorkspace { pattern, eta_rel } = ws;
+    let (n, m) = (op.n(), r0.len());
+    let eval = |r: &[V3], x: &[V3]| -> (Vec<PointLinearisation>, f64) {
+        let lin: Vec<_> = (0..m).map(|p| law(p, r[p], x[p])).collect();
+        let theta = lin.iter().flat_map(|l| l.phi).map(|v| 0.5 * v * v).sum();
+        (lin, theta)
+    };
+    // η in units of compliance: 1/ρ on average.
+    let eta_scale = if m > 0 {
+        rho.iter().map(|r| 1.0 / r).sum::<f64>() / m as f64
+    } else {
+        0.0
+    };
+    let (mut r, mut x) = (r0.to_vec(), x0.to_vec());
+    let mut du = vec![0.0; n];
+    let (mut lin, mut theta) = eval(&r, &x);
+    let mut iterations = 0;
+    loop {
+        let points: Vec<PointSolution> = lin.iter().map(|l| l.solution).collect();
+        let measured = measure(&points);
+        if measured <= tol || iterations >= max_iter {
+            return Ok(MixedSolution {
+                r,
+                points,
+                du,
+                residual: measured,
+                iterations,
+                converged: measured <= tol,
+            });
+        }
+        let residual = (2.0 * theta).sqrt();
+        iterations += 1;
+        // The regularisation vanishes with the residual relative to the forces.
+        let force = r.iter().flatten().map(|v| v * v).sum::<f64>().sqrt();
+        let eta = eta_scale * eta_rel.min(residual / (force + residual));
+        let (entries, values) = op.entries(&lin, eta);
+        if pattern.as_ref().is_none_or(|pt| pt.entries != entries) {
+            *pattern = Some(MixedPattern::new(op, entries)?);
+        }
+        let mut sol = vec![0.0; n + 3 * m];
+        for (p, l) in lin.iter().enumerate() {
+            for k in 0..3 {
+                sol[n + 3 * p + k] = -l.phi[k];
+            }
+        }
+        let solved = pattern
+            .as_mut()
+            .expect("set above")
+            .solve(&values, &mut sol);
+        let mut accepted = false;
+        if solved {
+            let (du_dir, d) = sol.split_at(n);
+            let x_dir: Vec<V3> = (0..m).map(|p| op.apply_h(p, du_dir)).collect();
+            let mut t = 1.0;
+            while t >= MIN_STEP {
+                let r_try: Vec<V3> = (0..m)
+                    .map(|p| std::array::from_fn(|k| r[p][k] + t * d[3 * p + k]))
+                    .collect();
+                let x_try: Vec<V3> = (0..m)
+                    .map(|p| std::array::from_fn(|k| x[p][k] + t * x_dir[p][k]))
+                    .collect();
+                let (lin_try, theta_try) = eval(&r_try, &x_try);
+                if theta_try <= (1.0 - 2.0 * ARMIJO * t) * theta {
+                    (r, x, lin, theta) = (r_try, x_try, lin_try, theta_try);
+                    for (u, dd) in du.iter_mut().zip(du_dir) {
+                        *u += t * dd;
+                    }
+                    *eta_rel = if t == 1.0 {
+                        (*eta_rel * ETA_DOWN).max(ETA_MIN)
+                    } else {
+                        (*eta_rel * ETA_UP).min(ETA_MAX)
+                    };
+                    accepted = true;
+                    break;
+                }
+                t *= 0.5;
+            }
+        }
+        if !accepted {
+            if *eta_rel >= ETA_MAX {
+                let points: Vec<PointSolution> = lin.iter().map(|l| l.solution).collect();
+                return Ok(MixedSolution {
+                    residual: measure(&points),
+                    r,
+                    points,
+                    du,
+                    iterations,
+                    converged: false,
+                });
+            }
+            *eta_rel = (*eta_rel * ETA_UP).min(ETA_MAX);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::anisotropic::Orthotropy;
+    use super::super::law::RccParams;
+    use super::super::reduced::test_support::{random_spd, Lcg};
+    use super::super::reduced::BlockSparseDelassus;
+    use super::super::semismooth::semismooth_newton;
+    use super::*;
+
+    /// Central differences of Φ with respect to r (columns of A) and x (columns of B).
+    fn fd_jacobians(f: impl Fn(V3, V3) -> V3, r: V3, x: V3, hr: f64, hx: f64) -> (Mat3, Mat3) {
+        let mut a = Mat3::zeros();
+        let mut b = Mat3::zeros();
+        for j in 0..3 {
+            let (mut rp, mut rm, mut xp, mut xm) = (r, r, x, x);
+            rp[j] += hr;
+            rm[j] -= hr;
+            xp[j] += hx;
+            xm[j] -= hx;
+            let (fp, fm) = (f(rp, x), f(rm, x));
+            let (gp, gm) = (f(r, xp), f(r, xm));
+            for i in 0..3 {
+                a[(i, j)] = (fp[i] - fm[i]) / (2.0 * hr);
+                b[(i, j)] = (gp[i] - gm[i]) / (2.0 * hx);
+            }
+        }
+        (a, b)
+    }
+
+    /// A and B are the derivatives of Φ (to 1e-6 of their size, the central differences'
+    /// truncation error at steps of 1e-6 of the variables) away from the kinks of the
+    /// projection: sticking, sliding and separating points, dry and bonded (β held at its
+    /// ceiling 1, where the adhesive stiffness at fixed β is the whole derivative), isotropic
+    /// and orthotropic.
+    #[test]
+    fn linearisation_matches_finite_differences() {
+        let rcc = RccParams::new(1.0, 1e6, 5e5, 0.0);
+        let bonded = BondState {
+            beta: 1.0,
+            ut: [0.0; 2],
+            damage: 0.0,
+        };
+        let laws = [
+            InterfaceLaw {
+                mu: 0.3,
+                adhesion: None,
+                anisotropy: None,
+            },
+            InterfaceLaw {
+                mu: 0.5,
+                adhesion: Some(rcc),
+                anisotropy: None,
+            },
+            InterfaceLaw {
+                mu: 0.3,
+                adhesion: None,
+                anisotropy: Some(Orthotropy {
+                    axis: [1.0, 0.0, 0.0],
+                    mu2: 0.6,
+                }),
+            },
+        ];
+        let rho = 1e3;
+        // (r, x) of a stick, a slide and a separating point.
+        let cases: [(V3, V3); 3] = [
+            ([0.1, -0.05, 1.0], [0.0, 0.0, 0.0]),
+            ([0.5, 0.3, 1.0], [-2e-4, -1e-4, 1e-5]),
+            ([0.01, 0.0, 0.05], [1e-5, 0.0, 2e-4]),
+        ];
+        let mut checked = 0;
+        for law in &laws {
+            for &(r, x) in &cases {
+                let lin = |r: V3, x: V3| linearise_point(law, bonded, 1e-3, 1e-6, rho, r, x);
+                let l = lin(r, x);
+                let (a, b) = fd_jacobians(|r, x| lin(r, x).phi, r, x, 1e-7, 1e-10);
+                // The trial point stays on one side of every kink within the steps.
+                let scale_a = l.a.norm().max(1.0);
+                let scale_b = l.b.norm().max(rho);
+                assert!(
+                    (a - l.a).norm() <= 1e-6 * scale_a,
+                    "{law:?} at {r:?}, {x:?}: A {} vs {}",
+                    l.a,
+                    a
+                );
+                assert!(
+                    (b - l.b).norm() <= 1e-6 * scale_b,
+                    "{law:?} at {r:?}, {x:?}: B {} vs {}",
+                    l.b,
+                    b
+                );
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 9);
+    }
+
+    /// The mixed solve on (K, H) finds the solution of the reduced problem on W = H K⁻¹ Hᵀ,
+    /// q = x₀ (forces to 1e-8 of their size, both solved to 1e-12), and its δu is K⁻¹Hᵀr:
+    /// the same problem, without forming W.
+    #[test]
+    fn mixed_solve_matches_the_reduced_problem() {
+        for seed in 1..5u64 {
+            let mut rng = Lcg(seed);
+            let (n, m) = (12, 3);
+            let k = random_spd(&mut rng, n, 1.0);
+            let kmat = nalgebra::DMatrix::from_row_slice(n, n, &k);
+            let mut col_ptr = vec![0];
+            let (mut row_idx, mut values) = (Vec::new(), Vec::new());
+            for j in 0..n {
+                for i in 0..=j {
+                    row_idx.push(i);
+                    values.push(kmat[(i, j)]);
+                }
+                col_ptr.push(row_idx.len());
+            }
+            // Each point reads the three unknowns of its own node and, with weight −½, those
+            // of the next node (a master face).
+            let h: Vec<Vec<(usize, V3)>> = (0..m)
+                .map(|p| {
+                    let mut terms = Vec::new();
+                    for (node, w) in [(p, 1.0), (p + 1, -0.5)] {
+                        for c in 0..3 {
+                            let mut coef = [0.0; 3];
+                            coef[c] = w;
+                            terms.push((3 * node + c, coef));
+                        }
+                    }
+                    terms
+                })
+                .collect();
+            let mut hmat = nalgebra::DMatrix::zeros(3 * m, n);
+            for (p, terms) in h.iter().enumerate() {
+                for &(i, c) in terms {
+                    for a in 0..3 {
+                        hmat[(3 * p + a, i)] += c[a];
+                    }
+                }
+            }
+            let kinv = kmat.clone().try_inverse().expect("SPD");
+            let w = &hmat * &kinv * hmat.transpose();
+            let mut rnd = || rng.next_centered();
+            let x0: Vec<V3> = (0..m).map(|_| [rnd(), rnd(), rnd() - 0.4]).collect();
+            let mu = vec![0.3; m];
+            let wd = BlockSparseDelassus::from_dense(m, w.as_slice());
+            // nalgebra is column-major and W symmetric: the slice is W row-major too.
+            let (reference, _) = semismooth_newton(&wd, &x0, &mu, &vec![[0.0; 3]; m], 1e-12, 100);
+            assert!(reference.converged);
+            let law = InterfaceLaw {
+                mu: 0.3,
+                adhesion: None,
+                anisotropy: None,
+            };
+            let rho: Vec<f64> = (0..m).map(|p| 1.0 / w[(3 * p + 2, 3 * p + 2)]).collect();
+            let op = MixedOperator {
+                col_ptr: &col_ptr,
+                row_idx: &row_idx,
+                values: &values,
+                h: &h,
+            };
+            let bond = BondState {
+                beta: 0.0,
+                ut: [0.0; 2],
+                damage: 0.0,
+            };
+            let lin = |p: usize, r: V3, x: V3| linearise_point(&law, bond, 1.0, 1.0, rho[p], r, x);
+            let force: f64 = reference
+                .r
+                .iter()
+                .flatten()
+                .map(|v| v * v)
+                .sum::<f64>()
+                .sqrt();
+            let mut ws = MixedWorkspace::default();
+            let phi = |pts: &[PointSolution]| {
+                let defects = pts.iter().zip(&rho).map(|(pt, &rho)| {
+                    super::super::law::natural_map_defect(&law, rho, pt.r_dry, pt.x)
+                });
+                defects.flatten().map(|v| v * v).sum::<f64>().sqrt()
+            };
+            let r0 = vec![[0.0; 3]; m];
+            let sol = solve_mixed(&op, lin, phi, &rho, &r0, &x0, 1e-12 * force, 100, &mut ws)
+                .expect("analysis");
+            assert!(sol.converged, "seed {seed}: residual {}", sol.residual);
+            for (a, b) in sol.r.iter().zip(&reference.r) {
+                for c in 0..3 {
+                    assert!(
+                        (a[c] - b[c]).abs() <= 1e-8 * force,
+                        "seed {seed}: {a:?} vs {b:?}"
+                    );
+                }
+            }
+            let r = nalgebra::DVector::from_iterator(3 * m, sol.r.iter().flatten().copied());
+            let du = &kinv * hmat.transpose() * r;
+            let du_norm = du.norm();
+            for (a, b) in sol.du.iter().zip(du.iter()) {
+                assert!(
+                    (a - b).abs() <= 1e-8 * du_norm,
+                    "seed {seed}: δu {a} vs {b}"
+                );
+            }
+            // Not a trivial case: some point carries a force.
+            assert!(force > 0.0, "seed {seed}");
+        }
+    }
+}
