@@ -177,6 +177,23 @@ impl SystemMatrix {
         &self.fixed
     }
 
+    /// Replaces the matrix's values by `values` (e.g. those of [`Self::factorised_matrix`]
+    /// kept from an earlier factorisation); factorise again before solving.
+    pub fn set_values(&mut self, values: &[f64]) {
+        self.values.copy_from_slice(values);
+    }
+
+    /// The pattern in use (upper triangle).
+    pub fn pattern(&self) -> &BlockPattern {
+        &self.pattern
+    }
+
+    /// Solves with the factorised matrix as it is, ties included (right-hand sides and
+    /// solutions on the representatives' unknowns, zero on the tied nodes' own).
+    pub fn solve_condensed(&mut self, rhs: &mut [f64]) {
+        self.chol.solve_in_place(rhs);
+    }
+
     /// Copies the unknowns of each representative to the nodes tied to it.
     pub fn expand_tied(&self, v: &mut [f64]) {
         for &(t, r) in &self.tied_nodes {

@@ -654,7 +654,8 @@ impl Stepper {
         let system = &mut self.system;
         let coupling: Box<dyn ContactCoupling<'_> + '_> = match (settings.contact_solver, lambda) {
             (ContactSolver::Semismooth, Some(r0)) => {
-                Box::new(MixedCoupling::new(contact, r0, &mut self.mixed_workspace))
+                let ws = &mut self.mixed_workspace;
+                Box::new(MixedCoupling::new(contact, r0, ws, system)?)
             }
             (_, Some(lambda)) => Box::new(NewtonCoupling::new(contact, lambda, system)?),
             (_, None) => Box::new(DelassusCoupling::new(contact, &mut self.delassus_cache)),

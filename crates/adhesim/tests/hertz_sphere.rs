@@ -426,12 +426,22 @@ fn hertz_force_and_contact_radius_converge_to_the_half_space_solution() {
 /// the candidates far from the sphere must not change the answer.
 #[test]
 fn hertz_with_two_thousand_contact_candidates() {
+    hertz_with_every_surface_node_a_candidate(ContactSolver::Newton);
+}
+
+/// The same on the semismooth contact solve, which never forms W either.
+#[test]
+fn hertz_with_two_thousand_contact_candidates_semismooth() {
+    hertz_with_every_surface_node_a_candidate(ContactSolver::Semismooth);
+}
+
+fn hertz_with_every_surface_node_a_candidate(solver: ContactSolver) {
     let a = (R * D).sqrt();
     let e_star = 2.5 * G / (1.0 - 0.25f64.powi(2));
     let f_hertz = 4.0 / 3.0 * e_star * R.sqrt() * D.powf(1.5);
-    let r = indent(12, 1.0, ContactSolver::Newton);
+    let r = indent(12, 1.0, solver);
     eprintln!(
-        "h = a/8, every surface node a candidate: F = {:.5e} N (error {:+.2} %), {} dofs, \
+        "{solver:?}, h = a/8, every surface node a candidate: F = {:.5e} N (error {:+.2} %), {} dofs, \
          {} contact candidates, {} Newton iterations, {:.1} s",
         r.force,
         100.0 * (r.force / f_hertz - 1.0),

@@ -51,6 +51,9 @@ const ETA_MIN: f64 = 1e-12;
 const ETA_MAX: f64 = 1.0;
 const ETA_DOWN: f64 = 0.1;
 const ETA_UP: f64 = 10.0;
+/// Relative round-off of the natural map: the solve stops once the measure is below this
+/// fraction of the forces' norm, whatever the tolerance asked.
+const ROUND_OFF: f64 = 1e-13;
 
 /// The natural map of one point linearised at (r, x).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -61,6 +64,9 @@ pub struct PointLinearisation {
     pub a: Mat3,
     /// ∂Φ/∂x [N/m] (with the adhesive stiffness at fixed β₁).
     pub b: Mat3,
+    /// B without the change of x̂'s normal component with the slip (D = I): what makes B
+    /// unsymmetric for a sliding point [N/m].
+    pub b_plain: Mat3,
     /// The point's forces, β₁, bond stretch and case at (r, x).
     pub solution: PointSolution,
 }
@@ -106,11 +112,13 @@ pub fn linearise_point(
     let t_inv = Mat3::from_diagonal(&unscale([1.0; 3], s).into());
     let a = t * (Mat3::identity() - pj) * t_inv;
     let b = a * k_adh + t * (rho * pj * d) * t;
+    let b_plain = a * k_adh + t * (rho * pj) * t;
     let phi = scale(std::array::from_fn(|k| ys[k] - proj[k]), s);
     PointLinearisation {
         phi,
         a,
         b,
+        b_plain,
         solution: PointSolution {
             r_dry: y,
             r_adh,
@@ -262,8 +270,10 @@ impl MixedPattern {
 /// What [`solve_mixed`] keeps between calls: the LU analysis (redone when the entries
 /// differ) and the regularisation's current level.
 pub struct MixedWorkspace {
-    pattern: Option<MixedPattern>,
-    eta_rel: f64,
+    /// The LU analysis of the mixed matrix (when the LU computes the directions).
+    pub pattern: Option<MixedPattern>,
+    /// The regularisation's level η / mean(1/ρ).
+    pub eta_rel: f64,
 }
 
 impl Default for MixedWorkspace {
@@ -300,15 +310,85 @@ pub struct MixedSolution {
     pub converged: bool,
 }
 
+/// A semismooth Newton direction of the mixed system: the displacement part δu, the force
+/// part d and x's change along it, H δu (= W d).
+pub struct Direction {
+    /// δu [m] on the unknowns of the system.
+    pub du: Vec<f64>,
+    /// d [N] per point, local frames.
+    pub d: Vec<V3>,
+    /// H δu [m] per point.
+    pub x: Vec<V3>,
+}
+
+/// A way of computing the direction of the mixed system for the points' linearisations.
+pub trait MixedDirection {
+    /// Number of unknowns of the displacement part.
+    fn unknowns(&self) -> usize;
+    /// Smallest regularisation η, relative to the mean 1/ρ, this way can work with.
+    fn eta_floor(&self) -> f64 {
+        ETA_MIN
+    }
+    /// The direction for the linearisations `lin` with regularisation `eta` [m/N]; `None`
+    /// when it cannot be computed (a singular matrix, values that are not finite).
+    fn direction(
+        &mut self,
+        lin: &[PointLinearisation],
+        eta: f64,
+    ) -> Result<Option<Direction>, String>;
+}
+
+/// The direction from a sparse LU factorisation of the whole mixed matrix.
+pub struct LuDirection<'a, 'b> {
+    /// K̄ and H.
+    pub op: &'a MixedOperator<'b>,
+    /// The LU analysis, redone when the entries differ.
+    pub pattern: &'a mut Option<MixedPattern>,
+}
+
+impl MixedDirection for LuDirection<'_, '_> {
+    fn unknowns(&self) -> usize {
+        self.op.n()
+    }
+
+    fn direction(
+        &mut self,
+        lin: &[PointLinearisation],
+        eta: f64,
+    ) -> Result<Option<Direction>, String> {
+        let (n, m) = (self.op.n(), lin.len());
+        let (entries, values) = self.op.entries(lin, eta);
+        if self.pattern.as_ref().is_none_or(|pt| pt.entries != entries) {
+            *self.pattern = Some(MixedPattern::new(self.op, entries)?);
+        }
+        let mut sol = vec![0.0; n + 3 * m];
+        for (p, l) in lin.iter().enumerate() {
+            for k in 0..3 {
+                sol[n + 3 * p + k] = -l.phi[k];
+            }
+        }
+        let pattern = self.pattern.as_mut().expect("set above");
+        if !pattern.solve(&values, &mut sol) {
+            return Ok(None);
+        }
+        let d = (0..m)
+            .map(|p| std::array::from_fn(|k| sol[n + 3 * p + k]))
+            .collect();
+        sol.truncate(n);
+        let x = (0..m).map(|p| self.op.apply_h(p, &sol)).collect();
+        Ok(Some(Direction { du: sol, d, x }))
+    }
+}
+
 /// Semismooth Newton on the contact forces from `r0` (where the local displacements are `x0`
-/// [m]) until `measure` of the points' solutions is ≤ `tol` [N] or `max_iter` steps;
-/// `law(p, r, x)` linearises point p's law with its natural-map parameter `rho[p]` [N/m].
-/// `measure` is the caller's residual (e.g. the natural map with another ρ; Φ's norm with
-/// these ρ is the merit of the line search). `ws` carries the LU analysis and the
+/// [m]) until `measure` of the points' solutions is ≤ `tol` [N] or `max_iter` steps, with
+/// directions from `dir`; `law(p, r, x)` linearises point p's law with its natural-map
+/// parameter `rho[p]` [N/m]. `measure` is the caller's residual (e.g. the natural map with
+/// another ρ; Φ's norm with these ρ is the merit of the line search). `eta_rel` carries the
 /// regularisation level from call to call.
 #[allow(clippy::too_many_arguments)]
 pub fn solve_mixed(
-    op: &MixedOperator,
+    dir: &mut impl MixedDirection,
     law: impl Fn(usize, V3, V3) -> PointLinearisation,
     measure: impl Fn(&[PointSolution]) -> f64,
     rho: &[f64],
@@ -316,10 +396,9 @@ pub fn solve_mixed(
     x0: &[V3],
     tol: f64,
     max_iter: usize,
-    ws: &mut MixedWorkspace,
+    eta_rel: &mut f64,
 ) -> Result<MixedSolution, String> {
-    let MixedWorkspace { pattern, eta_rel } = ws;
-    let (n, m) = (op.n(), r0.len());
+    let (n, m) = (dir.unknowns(), r0.len());
     let eval = |r: &[V3], x: &[V3]| -> (Vec<PointLinearisation>, f64) {
         let lin: Vec<_> = (0..m).map(|p| law(p, r[p], x[p])).collect();
         let theta = lin.iter().flat_map(|l| l.phi).map(|v| 0.5 * v * v).sum();
@@ -334,55 +413,48 @@ pub fn solve_mixed(
     let (mut r, mut x) = (r0.to_vec(), x0.to_vec());
     let mut du = vec![0.0; n];
     let (mut lin, mut theta) = eval(&r, &x);
-    let mut iterations = 0;
+    let (mut iterations, mut stalled, mut failed) = (0, false, false);
     loop {
         let points: Vec<PointSolution> = lin.iter().map(|l| l.solution).collect();
         let measured = measure(&points);
-        if measured <= tol || iterations >= max_iter {
+        // Round-off of the forces bounds the measure from below: a step whose force scale
+        // is still zero (nothing loaded yet) cannot ask for less.
+        let force = r.iter().flatten().map(|v| v * v).sum::<f64>().sqrt();
+        let floor = ROUND_OFF * force;
+        if measured <= tol.max(floor) || iterations >= max_iter || stalled {
             return Ok(MixedSolution {
                 r,
                 points,
                 du,
                 residual: measured,
                 iterations,
-                converged: measured <= tol,
+                converged: measured <= tol.max(floor),
             });
         }
         let residual = (2.0 * theta).sqrt();
         iterations += 1;
-        // The regularisation vanishes with the residual relative to the forces.
-        let force = r.iter().flatten().map(|v| v * v).sum::<f64>().sqrt();
-        let eta = eta_scale * eta_rel.min(residual / (force + residual));
-        let (entries, values) = op.entries(&lin, eta);
-        if pattern.as_ref().is_none_or(|pt| pt.entries != entries) {
-            *pattern = Some(MixedPattern::new(op, entries)?);
-        }
-        let mut sol = vec![0.0; n + 3 * m];
-        for (p, l) in lin.iter().enumerate() {
-            for k in 0..3 {
-                sol[n + 3 * p + k] = -l.phi[k];
-            }
-        }
-        let solved = pattern
-            .as_mut()
-            .expect("set above")
-            .solve(&values, &mut sol);
+        // The regularisation vanishes with the residual relative to the forces, unless the
+        // last step failed (then it is raised).
+        let level = if failed {
+            *eta_rel
+        } else {
+            eta_rel.min(residual / (force + residual))
+        };
+        let level = level.max(dir.eta_floor());
         let mut accepted = false;
-        if solved {
-            let (du_dir, d) = sol.split_at(n);
-            let x_dir: Vec<V3> = (0..m).map(|p| op.apply_h(p, du_dir)).collect();
+        if let Some(step) = dir.direction(&lin, eta_scale * level)? {
             let mut t = 1.0;
             while t >= MIN_STEP {
                 let r_try: Vec<V3> = (0..m)
-                    .map(|p| std::array::from_fn(|k| r[p][k] + t * d[3 * p + k]))
+                    .map(|p| std::array::from_fn(|k| r[p][k] + t * step.d[p][k]))
                     .collect();
                 let x_try: Vec<V3> = (0..m)
-                    .map(|p| std::array::from_fn(|k| x[p][k] + t * x_dir[p][k]))
+                    .map(|p| std::array::from_fn(|k| x[p][k] + t * step.x[p][k]))
                     .collect();
                 let (lin_try, theta_try) = eval(&r_try, &x_try);
                 if theta_try <= (1.0 - 2.0 * ARMIJO * t) * theta {
                     (r, x, lin, theta) = (r_try, x_try, lin_try, theta_try);
-                    for (u, dd) in du.iter_mut().zip(du_dir) {
+                    for (u, dd) in du.iter_mut().zip(&step.du) {
                         *u += t * dd;
                     }
                     *eta_rel = if t == 1.0 {
@@ -396,18 +468,10 @@ pub fn solve_mixed(
                 t *= 0.5;
             }
         }
-        if !accepted {
-            if *eta_rel >= ETA_MAX {
-                let points: Vec<PointSolution> = lin.iter().map(|l| l.solution).collect();
-                return Ok(MixedSolution {
-                    residual: measure(&points),
-                    r,
-                    points,
-                    du,
-                    iterations,
-                    converged: false,
-                });
-            }
+        failed = !accepted;
+        if failed {
+            // A failed step at the largest η ends the solve.
+            stalled = *eta_rel >= ETA_MAX;
             *eta_rel = (*eta_rel * ETA_UP).min(ETA_MAX);
         }
     }
@@ -585,7 +649,7 @@ mod tests {
                 .map(|v| v * v)
                 .sum::<f64>()
                 .sqrt();
-            let mut ws = MixedWorkspace::default();
+            let (mut pattern, mut eta_rel) = (None, ETA_START);
             let phi = |pts: &[PointSolution]| {
                 let defects = pts.iter().zip(&rho).map(|(pt, &rho)| {
                     super::super::law::natural_map_defect(&law, rho, pt.r_dry, pt.x)
@@ -593,7 +657,12 @@ mod tests {
                 defects.flatten().map(|v| v * v).sum::<f64>().sqrt()
             };
             let r0 = vec![[0.0; 3]; m];
-            let sol = solve_mixed(&op, lin, phi, &rho, &r0, &x0, 1e-12 * force, 100, &mut ws)
+            let mut dir = LuDirection {
+                op: &op,
+                pattern: &mut pattern,
+            };
+            let tol = 1e-12 * force;
+            let sol = solve_mixed(&mut dir, lin, phi, &rho, &r0, &x0, tol, 100, &mut eta_rel)
                 .expect("analysis");
             assert!(sol.converged, "seed {seed}: residual {}", sol.residual);
             for (a, b) in sol.r.iter().zip(&reference.r) {

@@ -8,9 +8,15 @@ use super::coupling::{ContactCoupling, Evaluated, Iterate, StepContact};
 use super::PhaseTimes;
 use crate::contact::detect::ContactPoint;
 use crate::contact::law::PointSolution;
-use crate::contact::mixed::{linearise_point, solve_mixed, MixedOperator, MixedWorkspace};
+use crate::contact::mixed::{
+    linearise_point, solve_mixed, Direction, LuDirection, MixedDirection, MixedOperator,
+    MixedPattern, MixedWorkspace, PointLinearisation,
+};
+use crate::contact::newton::add_contact_tangent;
 use crate::contact::newton::RHO_FACTOR;
+use crate::linalg::{gmres, BlockPattern};
 use crate::system::SystemMatrix;
+use crate::Mat3;
 use std::time::Instant;
 
 /// ρ_α of the natural map the Newton iterations work on, as a multiple of the stiffness K̄
@@ -48,11 +54,21 @@ impl<'a> MixedCoupling<'a> {
     /// The solve of the step with candidates `sc`, started from the contact forces `r0`
     /// (local frames) [N], e.g. the dry forces committed at the end of the last step.
     /// `workspace` keeps the LU analysis from step to step.
-    pub fn new(sc: StepContact<'a>, r0: Vec<[f64; 3]>, workspace: &'a mut MixedWorkspace) -> Self {
+    pub fn new(
+        sc: StepContact<'a>,
+        r0: Vec<[f64; 3]>,
+        workspace: &'a mut MixedWorkspace,
+        system: &mut SystemMatrix,
+    ) -> Result<Self, String> {
+        if !sc.is_empty() {
+            system
+                .ensure_couplings(&crate::contact::newton::couplings(&sc.points))
+                .map_err(|e| e.to_string())?;
+        }
         workspace.start_step();
         let n = sc.constraints.mask().len();
         let contact_force = sc.nodal_force(r0.iter().copied(), n);
-        MixedCoupling {
+        Ok(MixedCoupling {
             sc,
             h: Vec::new(),
             workspace,
@@ -61,7 +77,7 @@ impl<'a> MixedCoupling<'a> {
             contact_force,
             contact_residual: 0.0,
             iterations: 0,
-        }
+        })
     }
 }
 
@@ -151,25 +167,31 @@ impl<'a> ContactCoupling<'a> for MixedCoupling<'a> {
             let law = &sc.laws[pt.pair];
             linearise_point(law, sc.bond0[p], sc.dt, pt.area, rho[p], r, x)
         };
-        let solve =
-            |system: &SystemMatrix, r0: &[[f64; 3]], x0: &[[f64; 3]], ws: &mut MixedWorkspace| {
-                let (pattern, values) = system.factorised_matrix();
-                let op = MixedOperator {
-                    col_ptr: &pattern.col_ptr,
-                    row_idx: &pattern.row_idx,
-                    values,
-                    h,
-                };
-                let measure = |pts: &[PointSolution]| sc.natural_map(pts);
-                solve_mixed(&op, &law, measure, &rho, r0, x0, tol, MAX_INNER, ws)
+        let measure = |pts: &[PointSolution]| sc.natural_map(pts);
+        // K̄ as the Newton loop factorised it, and the pattern for products with it.
+        let base = system.factorised_matrix().1.to_vec();
+        let pattern = system.pattern().clone();
+        let mut solve = |system: &mut SystemMatrix, r0: &[[f64; 3]], x0: &[[f64; 3]]| {
+            let mut dir = CondensedDirection {
+                system,
+                base: &base,
+                pattern: &pattern,
+                points: &sc.points,
+                h,
+                lu: &mut self.workspace.pattern,
             };
-        let mut sol = solve(system, &self.r_contact, &x0, &mut *self.workspace)?;
+            let eta = &mut self.workspace.eta_rel;
+            solve_mixed(&mut dir, &law, measure, &rho, r0, x0, tol, MAX_INNER, eta)
+        };
+        let mut sol = solve(system, &self.r_contact, &x0)?;
         let mut iterations = sol.iterations;
         let mut shift = None;
         if !sol.converged && self.r_contact.iter().any(|r| *r != [0.0; 3]) {
             // Where a bond's branch ends (snap-off) the solution lies on another branch than
             // the one Newton follows from the last forces: start again from no contact force,
-            // x shifted by −W r_prev (one solve with the factorised K̄).
+            // x shifted by −W r_prev (one solve with K̄, factorised again).
+            system.set_values(&base);
+            system.factorise().map_err(|e| e.to_string())?;
             let mut d0 = sc.nodal_force(self.r_contact.iter().map(|r| r.map(|v| -v)), u.len());
             system.solve_in_place(&mut d0);
             let x0: Vec<[f64; 3]> = sc
@@ -182,7 +204,7 @@ impl<'a> ContactCoupling<'a> for MixedCoupling<'a> {
                 })
                 .collect();
             let zeros = vec![[0.0; 3]; x0.len()];
-            let again = solve(system, &zeros, &x0, &mut *self.workspace)?;
+            let again = solve(system, &zeros, &x0)?;
             iterations += again.iterations;
             if again.converged {
                 (sol, shift) = (again, Some(d0));
@@ -220,5 +242,167 @@ impl<'a> ContactCoupling<'a> for MixedCoupling<'a> {
 
     fn sweeps(&self) -> usize {
         self.iterations
+    }
+}
+
+/// Smallest regularisation η (relative to the mean 1/ρ) of the condensed directions: a
+/// sticking point enters K̄ as a spring of stiffness 1/η, so this bounds the penalty at 10⁸ ρ,
+/// which the Cholesky factorisation resolves to about 10⁻⁸; the residual Φ stays exact, so the
+/// Newton iterations still converge to the exact solution, at a rate of about this factor.
+const ETA_FLOOR: f64 = 1e-8;
+
+/// GMRES: relative tolerance, largest relative residual accepted, iteration limit, restart.
+const GMRES_TOL: f64 = 1e-10;
+const GMRES_ACCEPT: f64 = 1e-6;
+const GMRES_MAX: usize = 200;
+const GMRES_RESTART: usize = 40;
+
+/// Largest mixed matrix (unknowns plus three per contact point) factorised by LU when GMRES
+/// does not converge: a sparse LU with partial pivoting of a 3D mesh fills in much more than
+/// the Cholesky factor (about 0.6 GB at 18k rows, over 16 GB at 180k).
+const LU_FALLBACK_MAX: usize = 60_000;
+
+/// The direction of the mixed system without its LU: the force part eliminated point by
+/// point, d = −Ã⁻¹(Φ + B H δu) with Ã = A + ηB, leaves
+///
+///   (K̄ + Σ Hᵀ S H) δu = −Σ Hᵀ Ã⁻¹Φ,   S = Ã⁻¹B,
+///
+/// on the unknowns of K̄. S is symmetric for sticking (I/η), separating and bonded points and
+/// not for sliding ones (the friction force follows the normal one). The system is solved by
+/// GMRES preconditioned with the Cholesky factorisation of K̄ + Σ Hᵀ S₊ H, S₊ the positive
+/// part of S's symmetric part, which the step's sparse Cholesky (METIS ordering, K̄'s pattern
+/// extended by the contact couplings) factorises as it does K̄.
+struct CondensedDirection<'s> {
+    system: &'s mut SystemMatrix,
+    base: &'s [f64],
+    pattern: &'s BlockPattern,
+    points: &'s [ContactPoint],
+    h: &'s [Vec<(usize, [f64; 3])>],
+    /// The LU analysis of the whole mixed matrix, for directions GMRES cannot find.
+    lu: &'s mut Option<MixedPattern>,
+}
+
+/// H_α v from a point's list of (unknown, coefficients).
+fn apply_h(h: &[(usize, [f64; 3])], v: &[f64]) -> nalgebra::Vector3<f64> {
+    let mut out = nalgebra::Vector3::zeros();
+    for &(i, c) in h {
+        out += nalgebra::Vector3::from(c) * v[i];
+    }
+    out
+}
+
+/// Adds H_αᵀ f to `out`.
+fn add_ht(h: &[(usize, [f64; 3])], f: &nalgebra::Vector3<f64>, out: &mut [f64]) {
+    for &(i, c) in h {
+        out[i] += c[0] * f[0] + c[1] * f[1] + c[2] * f[2];
+    }
+}
+
+/// The positive part of the symmetric part of `s`.
+fn positive_symmetric_part(s: &Mat3) -> Mat3 {
+    let eig = ((s + s.transpose()) * 0.5).symmetric_eigen();
+    let clipped = eig.eigenvalues.map(|v| v.max(0.0));
+    eig.eigenvectors * Mat3::from_diagonal(&clipped) * eig.eigenvectors.transpose()
+}
+
+impl MixedDirection for CondensedDirection<'_> {
+    fn unknowns(&self) -> usize {
+        self.pattern.dim()
+    }
+
+    fn eta_floor(&self) -> f64 {
+        ETA_FLOOR
+    }
+
+    fn direction(
+        &mut self,
+        lin: &[PointLinearisation],
+        eta: f64,
+    ) -> Result<Option<Direction>, String> {
+        let m = lin.len();
+        let (mut s, mut g, mut positive) = (
+            Vec::with_capacity(m),
+            Vec::with_capacity(m),
+            Vec::with_capacity(m),
+        );
+        for l in lin {
+            let Some(inv) = (l.a + eta * l.b).try_inverse() else {
+                return Ok(None);
+            };
+            let sa = inv * l.b;
+            // The preconditioner's block: S with D = I, symmetric for a dry point (A and
+            // B then both functions of P'), its positive symmetric part otherwise.
+            let Some(inv_plain) = (l.a + eta * l.b_plain).try_inverse() else {
+                return Ok(None);
+            };
+            let p = positive_symmetric_part(&(inv_plain * l.b_plain));
+            positive.push(std::array::from_fn(|i| std::array::from_fn(|j| p[(i, j)])));
+            g.push(inv * nalgebra::Vector3::from(l.phi));
+            s.push(sa);
+        }
+        self.system.set_values(self.base);
+        add_contact_tangent(self.points, &positive, self.system);
+        if self.system.factorise().is_err() {
+            return Ok(None);
+        }
+        let n = self.pattern.dim();
+        let values = self.system.factorised_matrix().1.to_vec();
+        let mut rhs = vec![0.0; n];
+        for (h, ga) in self.h.iter().zip(&g) {
+            add_ht(h, &(-ga), &mut rhs);
+        }
+        // The part of S the preconditioner leaves out.
+        let rest: Vec<Mat3> = s
+            .iter()
+            .zip(&positive)
+            .map(|(sa, p)| sa - Mat3::from_fn(|i, j| p[i][j]))
+            .collect();
+        let (pattern, h) = (self.pattern, self.h);
+        let apply = |v: &[f64], out: &mut [f64]| {
+            out.iter_mut().for_each(|o| *o = 0.0);
+            pattern.symmetric_matvec(&values, v, out);
+            for (ha, ra) in h.iter().zip(&rest) {
+                if ra.iter().any(|&e| e != 0.0) {
+                    add_ht(ha, &(ra * apply_h(ha, v)), out);
+                }
+            }
+        };
+        let system = &mut *self.system;
+        let precondition = |v: &mut [f64]| system.solve_condensed(v);
+        let (du, outcome) = gmres(
+            apply,
+            precondition,
+            &rhs,
+            GMRES_TOL,
+            GMRES_MAX,
+            GMRES_RESTART,
+        );
+        if !(outcome.relative_residual <= GMRES_ACCEPT) {
+            // GMRES stalled (strongly coupled sliding points): the exact direction from the
+            // LU of the whole mixed matrix, where it fits in memory.
+            if n + 3 * m > LU_FALLBACK_MAX {
+                return Ok(None);
+            }
+            let op = MixedOperator {
+                col_ptr: &self.pattern.col_ptr,
+                row_idx: &self.pattern.row_idx,
+                values: self.base,
+                h: self.h,
+            };
+            let mut lu = LuDirection {
+                op: &op,
+                pattern: &mut *self.lu,
+            };
+            return lu.direction(lin, eta);
+        }
+        let x: Vec<nalgebra::Vector3<f64>> = self.h.iter().map(|ha| apply_h(ha, &du)).collect();
+        let d = s
+            .iter()
+            .zip(&g)
+            .zip(&x)
+            .map(|((sa, ga), xa)| (-ga - sa * xa).into())
+            .collect();
+        let x = x.into_iter().map(Into::into).collect();
+        Ok(Some(Direction { du, d, x }))
     }
 }
