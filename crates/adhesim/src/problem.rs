@@ -101,13 +101,32 @@ pub enum ContactSolver {
     /// The contact law inside the step's Newton loop, its generalised Jacobian in the sparse
     /// matrix, with augmented-Lagrangian multiplier updates: no Delassus operator.
     Newton,
-    /// Semismooth Newton on the contact forces with directions from sparse LU factorisations
-    /// of the mixed (displacement, force) matrix: no Delassus operator.
+    /// Semismooth Newton on the contact forces, each direction from the step's sparse
+    /// factorisation and GMRES: no Delassus operator.
     Semismooth,
     /// The reduced system on the dense Delassus operator W = H K̄⁻¹ Hᵀ, solved by nonlinear
     /// Gauss-Seidel over contact points (small problems, cross-checks).
-    #[default]
     GaussSeidel,
+    /// Gauss-Seidel for a step with fewer than [`AUTO_SEMISMOOTH_FROM`] contact candidates,
+    /// the semismooth solve from there on.
+    #[default]
+    Auto,
+}
+
+/// Contact candidates from which [`ContactSolver::Auto`] solves a step without W: below it
+/// Gauss-Seidel with a reused W is as fast or faster (about equal at 100 points, 3 times
+/// slower at 1,024, docs/contact-solver.md) and W is at most 18 MB.
+pub const AUTO_SEMISMOOTH_FROM: usize = 500;
+
+impl ContactSolver {
+    /// The solver used for a step with `candidates` contact candidates.
+    pub fn for_candidates(self, candidates: usize) -> ContactSolver {
+        match self {
+            ContactSolver::Auto if candidates >= AUTO_SEMISMOOTH_FROM => ContactSolver::Semismooth,
+            ContactSolver::Auto => ContactSolver::GaussSeidel,
+            other => other,
+        }
+    }
 }
 
 impl Default for TimeSettings {
@@ -123,7 +142,7 @@ impl Default for TimeSettings {
             max_newton: 25,
             lumped_mass: false,
             rayleigh: (0.0, 0.0),
-            contact_solver: ContactSolver::GaussSeidel,
+            contact_solver: ContactSolver::Auto,
             contact_tol: 1e-8,
         }
     }
@@ -247,5 +266,33 @@ mod tests {
         let r0 = ((x[0] - 1.0f64).powi(2) + (x[2] - 1.0f64).powi(2)).sqrt();
         let r1 = ((x[0] + u[0] - 1.0f64).powi(2) + (x[2] + u[2] - 1.0f64).powi(2)).sqrt();
         assert!((r0 - r1).abs() < 1e-14 && u[1].abs() < 1e-15);
+    }
+}
+
+#[cfg(test)]
+mod contact_solver_tests {
+    use super::*;
+
+    /// "auto" switches to the solve without W at the threshold; the named solvers are kept.
+    #[test]
+    fn auto_takes_the_solve_without_w_from_the_threshold_on() {
+        let auto = ContactSolver::Auto;
+        assert_eq!(auto.for_candidates(0), ContactSolver::GaussSeidel);
+        assert_eq!(
+            auto.for_candidates(AUTO_SEMISMOOTH_FROM - 1),
+            ContactSolver::GaussSeidel
+        );
+        assert_eq!(
+            auto.for_candidates(AUTO_SEMISMOOTH_FROM),
+            ContactSolver::Semismooth
+        );
+        for s in [
+            ContactSolver::GaussSeidel,
+            ContactSolver::Semismooth,
+            ContactSolver::Newton,
+        ] {
+            assert_eq!(s.for_candidates(10 * AUTO_SEMISMOOTH_FROM), s);
+            assert_eq!(s.for_candidates(1), s);
+        }
     }
 }

@@ -911,9 +911,10 @@ fn validate_time(t: &FileTime, ctx: &Ctx) -> Result<TimeSettings, ScenarioError>
         Some("newton") => ContactSolver::Newton,
         Some("gauss-seidel") => ContactSolver::GaussSeidel,
         Some("semismooth") => ContactSolver::Semismooth,
+        Some("auto") => ContactSolver::Auto,
         Some(m) => {
             return Err(ctx.err(format!(
-                "`time.contact_solver` = {m:?}; valid values are \"semismooth\", \"newton\" and \"gauss-seidel\""
+                "`time.contact_solver` = {m:?}; valid values are \"auto\", \"semismooth\", \"gauss-seidel\" and \"newton\""
             )))
         }
     };

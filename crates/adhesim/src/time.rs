@@ -647,12 +647,13 @@ impl Stepper {
         let f_ext1 = self.external_force(t1);
         let clock = Instant::now();
         let candidates = self.detect_contact(t1);
+        let solver = candidates.solver;
         let laws = self.problem.contacts.iter().map(|c| c.law).collect();
         let reference = &self.disc.reference;
         let (contact, lambda) =
             StepContact::new(candidates, laws, dt, reference, &self.constraints);
         let system = &mut self.system;
-        let coupling: Box<dyn ContactCoupling<'_> + '_> = match (settings.contact_solver, lambda) {
+        let coupling: Box<dyn ContactCoupling<'_> + '_> = match (solver, lambda) {
             (ContactSolver::Semismooth, Some(r0)) => {
                 let ws = &mut self.mixed_workspace;
                 Box::new(MixedCoupling::new(contact, r0, ws, system)?)
@@ -718,9 +719,15 @@ impl Stepper {
             })
             .sum::<f64>()
             .sqrt();
+        let solver = self
+            .problem
+            .time
+            .contact_solver
+            .for_candidates(points.len());
         Candidates {
-            multipliers: (self.problem.time.contact_solver != ContactSolver::GaussSeidel)
+            multipliers: (solver != ContactSolver::GaussSeidel)
                 .then(|| self.multipliers_at_start(&points)),
+            solver,
             bond0: self.bonds_at_start(&points),
             points,
             bond_strength,

@@ -1,6 +1,6 @@
 //! The contact problem of a Newton iteration solved without the Delassus operator: a
-//! semismooth Newton method on the contact forces whose directions come from one sparse LU
-//! factorisation of the mixed system in (displacement, force) (docs/contact-solver.md).
+//! semismooth Newton method on the contact forces whose directions solve the mixed system in
+//! (displacement, force) (docs/contact-solver.md).
 //!
 //! Within a Newton iteration of the step, K̄ is fixed and the local relative displacements are
 //! affine in the contact forces r (total, local frames):
@@ -20,12 +20,12 @@
 //!   ⎣ B H   A + ηB⎦ ⎣ d  ⎦ = ⎣ −Φ⎦,
 //!
 //! whose δu part gives x's change along d, H δu = W d, so that the line search on
-//! θ = ½‖Φ‖² evaluates trial points without any further solve. The matrix has the size of the
-//! unknowns plus three rows per contact point and the sparsity of K̄ and H: memory and cost grow
-//! like one factorisation of K̄, not like the square of the number of contacts. ηB is the
-//! proximal regularisation of [`super::semismooth`] (x + η r in place of x), which keeps the
-//! matrix regular when sticking points are more than the unknowns can satisfy, and vanishes as
-//! the residual does.
+//! θ = ½‖Φ‖² evaluates trial points without any further solve. [`solve_mixed`] takes the
+//! directions from a [`MixedDirection`]: [`LuDirection`] factorises the whole matrix by sparse
+//! LU; the time stepper eliminates the forces point by point and solves the rest with its
+//! sparse Cholesky factorisation and GMRES (`time::mixed_coupling`). ηB is a proximal
+//! regularisation (x + η r in place of x), which keeps the matrix regular when sticking points
+//! are more than the unknowns can satisfy, and vanishes as the residual does.
 
 use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
 

@@ -42,7 +42,9 @@ pub struct Candidates {
     pub bond0: Vec<BondState>,
     /// Force their bonds can carry [N] (see [`StepContact::bond_strength`]).
     pub bond_strength: f64,
-    /// Multipliers the Newton contact solve starts from (None: the Gauss-Seidel solve).
+    /// The solver of the step.
+    pub solver: crate::problem::ContactSolver,
+    /// Forces (multipliers) the solves without W start from (None: the Gauss-Seidel solve).
     pub multipliers: Option<Vec<[f64; 3]>>,
 }
 
