@@ -485,6 +485,174 @@ impl ReducedProblem {
     }
 }
 
+/// What [`solve_global`] found, in adhesim's (t1, t2, n) order.
+#[derive(Clone, Debug)]
+pub struct GlobalSolution {
+    /// Contact forces per contact.
+    pub r: Vec<[f64; 3]>,
+    /// Relative velocities u = Hᵀ v + w per contact.
+    pub u: Vec<[f64; 3]>,
+    /// Semismooth Newton steps (each one sparse LU factorisation of the mixed matrix).
+    pub iterations: usize,
+    /// Siconos's relative error ‖F_nat(r)‖ / max(‖q‖, ‖r‖, ‖u‖), q = Hᵀ M⁻¹ f + w.
+    pub error: f64,
+    /// Whether the error is ≤ the tolerance.
+    pub converged: bool,
+}
+
+/// Solves a global problem without condensing it: the semismooth Newton method of
+/// `adhesim::contact::mixed` on the mixed system in (v, r), with M in place of K̄ and fclib's H
+/// (each contact reads u = H_αᵀ v + w_α). W = Hᵀ M⁻¹ H is never formed; each Newton step
+/// factorises the sparse mixed matrix (unknowns plus three rows per contact) by LU, and one more
+/// sparse LU of M gives the start q = Hᵀ M⁻¹ f + w. ρ_α = 3/λ_max of Σ_i h_i h_iᵀ/M_ii (W_αα
+/// exactly when M is diagonal). Stops on Siconos's error ≤ `tol` or after `max_iter` steps.
+pub fn solve_global(
+    p: &GlobalProblem,
+    tol: f64,
+    max_iter: usize,
+) -> Result<GlobalSolution, String> {
+    use adhesim::contact::law::{BondState, InterfaceLaw, PointSolution};
+    use adhesim::contact::mixed::{linearise_point, solve_mixed, LuDirection, MixedOperator};
+    use adhesim::contact::natural_map::{natural_map_residual, relative_error};
+    use std::collections::BTreeMap;
+
+    let n = p.m.rows;
+    let nc = p.mu.len();
+    // M's upper triangle, from whichever triangle(s) the file stores.
+    let mut full: BTreeMap<(usize, usize), f64> = BTreeMap::new();
+    for &(i, j, v) in &p.m.entries {
+        *full.entry((i, j)).or_insert(0.0) += v;
+    }
+    let mut upper: BTreeMap<(usize, usize), f64> = BTreeMap::new();
+    for (&(i, j), &v) in &full {
+        let (a, b) = (i.min(j), i.max(j));
+        let mirrored = full.contains_key(&(j, i)) && i != j;
+        *upper.entry((b, a)).or_insert(0.0) += if mirrored { 0.5 * v } else { v };
+    }
+    // Compressed columns of the upper triangle (keys are (column, row), sorted).
+    let mut col_ptr = vec![0usize; n + 1];
+    let mut row_idx = Vec::with_capacity(upper.len());
+    let mut values = Vec::with_capacity(upper.len());
+    for (&(j, i), &v) in &upper {
+        col_ptr[j + 1] += 1;
+        row_idx.push(i);
+        values.push(v);
+    }
+    for j in 0..n {
+        col_ptr[j + 1] += col_ptr[j];
+    }
+    // H per contact in adhesim's component order.
+    let mut h: Vec<BTreeMap<usize, [f64; 3]>> = vec![BTreeMap::new(); nc];
+    for &(i, col, v) in &p.h.entries {
+        let (c, k) = (col / 3, to_adhesim(col % 3));
+        h[c].entry(i).or_insert([0.0; 3])[k] += v;
+    }
+    let h: Vec<Vec<(usize, [f64; 3])>> = h.into_iter().map(|m| m.into_iter().collect()).collect();
+    // q = Hᵀ M⁻¹ f + w by a sparse LU of M (its full pattern, natural column order).
+    let mut m_cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
+    for (&(j, i), &v) in &upper {
+        m_cols[j].push((i, v));
+        if i != j {
+            m_cols[i].push((j, v));
+        }
+    }
+    let mut mp = vec![0usize];
+    let (mut mi, mut mv) = (Vec::new(), Vec::new());
+    for col in &mut m_cols {
+        col.sort_by_key(|e| e.0);
+        mi.extend(col.iter().map(|e| e.0));
+        mv.extend(col.iter().map(|e| e.1));
+        mp.push(mi.len());
+    }
+    let ident: Vec<usize> = (0..n).collect();
+    let mut lu = adhesim::sparse_lu::OrderedLu::analyse(mp, mi, ident.clone(), ident)
+        .map_err(|e| format!("M: {e}"))?;
+    lu.factorise(&mv).map_err(|e| format!("M: {e}"))?;
+    let mut v0 = p.f.clone();
+    lu.solve_in_place(&mut v0);
+    let w = triples_to_adhesim(&p.w);
+    let q: Vec<[f64; 3]> = (0..nc)
+        .map(|c| {
+            let mut u = w[c];
+            for &(i, coef) in &h[c] {
+                for k in 0..3 {
+                    u[k] += coef[k] * v0[i];
+                }
+            }
+            u
+        })
+        .collect();
+    // ρ from the diagonal of M.
+    let diag: Vec<f64> = (0..n)
+        .map(|j| upper.get(&(j, j)).copied().unwrap_or(0.0))
+        .collect();
+    let rho: Vec<f64> = h
+        .iter()
+        .map(|terms| {
+            let mut wd = nalgebra::Matrix3::<f64>::zeros();
+            for &(i, c) in terms {
+                if diag[i] > 0.0 {
+                    let c = nalgebra::Vector3::from(c);
+                    wd += c * c.transpose() / diag[i];
+                }
+            }
+            let lmax = wd.symmetric_eigenvalues().max();
+            if lmax > 0.0 {
+                3.0 / lmax
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let laws: Vec<InterfaceLaw> =
+        p.mu.iter()
+            .map(|&mu| InterfaceLaw {
+                mu,
+                adhesion: None,
+                anisotropy: None,
+            })
+            .collect();
+    let law = |c: usize, r: [f64; 3], x: [f64; 3]| {
+        linearise_point(&laws[c], BondState::default(), 1.0, 1.0, rho[c], r, x)
+    };
+    let error = |pts: &[PointSolution]| {
+        let r: Vec<[f64; 3]> = pts.iter().map(|s| s.r_dry).collect();
+        let x: Vec<[f64; 3]> = pts.iter().map(|s| s.x).collect();
+        relative_error(natural_map_residual(&r, &x, &p.mu), &q, &r, &x)
+    };
+    let op = MixedOperator {
+        col_ptr: &col_ptr,
+        row_idx: &row_idx,
+        values: &values,
+        h: &h,
+    };
+    let mut pattern = None;
+    let mut dir = LuDirection {
+        op: &op,
+        pattern: &mut pattern,
+    };
+    let mut eta_rel = 1e-2;
+    let r0 = vec![[0.0; 3]; nc];
+    let sol = solve_mixed(
+        &mut dir,
+        law,
+        error,
+        &rho,
+        &r0,
+        &q,
+        tol,
+        max_iter,
+        &mut eta_rel,
+    )?;
+    Ok(GlobalSolution {
+        u: sol.points.iter().map(|s| s.x).collect(),
+        r: sol.r,
+        iterations: sol.iterations,
+        error: sol.residual,
+        converged: sol.converged,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
