@@ -1,8 +1,10 @@
 //! The semismooth Newton contact solve without the Delassus operator
 //! (docs/contact-solver.md): after each Newton correction of the step, the same reduced
 //! contact problem as the Gauss-Seidel solve, x = x(u) + H Δu + W (r − r_prev), is solved by
-//! [`crate::contact::mixed::solve_mixed`], whose directions come from sparse LU
-//! factorisations of the mixed (displacement, force) matrix instead of W.
+//! [`crate::contact::mixed::solve_mixed`] without W: each direction of the mixed
+//! (displacement, force) system comes from the step's sparse Cholesky factorisation with the
+//! points' condensed blocks and GMRES ([`CondensedDirection`]). Its factorisations are counted
+//! in the contact phase (`time_contact_solve`), not in `time_factorisation`.
 
 use super::coupling::{ContactCoupling, Evaluated, Iterate, StepContact};
 use super::PhaseTimes;
@@ -26,10 +28,10 @@ use std::time::Instant;
 /// augmented-Lagrangian solve).
 const NATURAL_MAP_RHO: f64 = 1.0;
 
-/// The contact solve stops when the natural map is below this fraction of the step's force scale, or
-/// below [`FORCING`] times the out-of-balance force the correction started from, whichever
-/// is larger (an inexact Newton method: early iterations of the step need no exact contact
-/// solve).
+/// The contact solve stops when the natural map is below this fraction of the step's force
+/// scale, or below [`FORCING`] times the out-of-balance force the correction started from,
+/// whichever is larger (an inexact Newton method: early iterations of the step need no exact
+/// contact solve).
 const INNER_TOL: f64 = 1e-10;
 const FORCING: f64 = 1e-2;
 
@@ -53,7 +55,7 @@ pub struct MixedCoupling<'a> {
 impl<'a> MixedCoupling<'a> {
     /// The solve of the step with candidates `sc`, started from the contact forces `r0`
     /// (local frames) [N], e.g. the dry forces committed at the end of the last step.
-    /// `workspace` keeps the LU analysis from step to step.
+    /// `workspace` keeps the LU analysis (for directions GMRES cannot find) from step to step.
     pub fn new(
         sc: StepContact<'a>,
         r0: Vec<[f64; 3]>,
