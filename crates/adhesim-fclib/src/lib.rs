@@ -16,7 +16,7 @@
 
 use std::path::{Path, PathBuf};
 
-use adhesim::contact::reduced::BlockSparseDelassus;
+use adhesim::contact::reduced::{BlockSparseDelassus, ReducedSolution};
 use nalgebra::{DMatrix, DVector};
 
 /// A failure to read an fclib file: the file, the dataset and what went wrong.
@@ -485,32 +485,19 @@ impl ReducedProblem {
     }
 }
 
-/// What [`solve_global`] found, in adhesim's (t1, t2, n) order.
-#[derive(Clone, Debug)]
-pub struct GlobalSolution {
-    /// Contact forces per contact.
-    pub r: Vec<[f64; 3]>,
-    /// Relative velocities u = Hᵀ v + w per contact.
-    pub u: Vec<[f64; 3]>,
-    /// Semismooth Newton steps (each one sparse LU factorisation of the mixed matrix).
-    pub iterations: usize,
-    /// Siconos's relative error ‖F_nat(r)‖ / max(‖q‖, ‖r‖, ‖u‖), q = Hᵀ M⁻¹ f + w.
-    pub error: f64,
-    /// Whether the error is ≤ the tolerance.
-    pub converged: bool,
-}
-
 /// Solves a global problem without condensing it: the semismooth Newton method of
 /// `adhesim::contact::mixed` on the mixed system in (v, r), with M in place of K̄ and fclib's H
 /// (each contact reads u = H_αᵀ v + w_α). W = Hᵀ M⁻¹ H is never formed; each Newton step
 /// factorises the sparse mixed matrix (unknowns plus three rows per contact) by LU, and one more
 /// sparse LU of M gives the start q = Hᵀ M⁻¹ f + w. ρ_α = 3/λ_max of Σ_i h_i h_iᵀ/M_ii (W_αα
 /// exactly when M is diagonal). Stops on Siconos's error ≤ `tol` or after `max_iter` steps.
+/// The solution is in adhesim's (t1, t2, n) order, with x the relative velocities
+/// u = Hᵀ v + w and `iterations` the Newton steps (each one sparse LU factorisation).
 pub fn solve_global(
     p: &GlobalProblem,
     tol: f64,
     max_iter: usize,
-) -> Result<GlobalSolution, String> {
+) -> Result<ReducedSolution, String> {
     use adhesim::contact::law::{BondState, InterfaceLaw, PointSolution};
     use adhesim::contact::mixed::{linearise_point, solve_mixed, LuDirection, MixedOperator};
     use adhesim::contact::natural_map::{natural_map_residual, relative_error};
@@ -604,14 +591,7 @@ pub fn solve_global(
             }
         })
         .collect();
-    let laws: Vec<InterfaceLaw> =
-        p.mu.iter()
-            .map(|&mu| InterfaceLaw {
-                mu,
-                adhesion: None,
-                anisotropy: None,
-            })
-            .collect();
+    let laws: Vec<InterfaceLaw> = p.mu.iter().map(|&mu| InterfaceLaw::coulomb(mu)).collect();
     let law = |c: usize, r: [f64; 3], x: [f64; 3]| {
         linearise_point(&laws[c], BondState::default(), 1.0, 1.0, rho[c], r, x)
     };
@@ -644,9 +624,11 @@ pub fn solve_global(
         max_iter,
         &mut eta_rel,
     )?;
-    Ok(GlobalSolution {
-        u: sol.points.iter().map(|s| s.x).collect(),
+    let x: Vec<[f64; 3]> = sol.points.iter().map(|s| s.x).collect();
+    Ok(ReducedSolution {
+        residual: natural_map_residual(&sol.r, &x, &p.mu),
         r: sol.r,
+        x,
         iterations: sol.iterations,
         error: sol.residual,
         converged: sol.converged,

@@ -188,10 +188,12 @@ impl SystemMatrix {
         &self.pattern
     }
 
-    /// Solves with the factorised matrix as it is, ties included (right-hand sides and
-    /// solutions on the representatives' unknowns, zero on the tied nodes' own).
-    pub fn solve_condensed(&mut self, rhs: &mut [f64]) {
-        self.chol.solve_in_place(rhs);
+    /// The factorised matrix for products (pattern, upper-triangle values) and its
+    /// factorisation for solves, borrowed apart so that an iterative solve preconditioned by
+    /// the factorisation can use both. Both act on the matrix as factorised, ties included
+    /// (vectors on the representatives' unknowns, zero on the tied nodes' own).
+    pub fn operator_and_factor(&mut self) -> (&BlockPattern, &[f64], &mut SparseCholesky) {
+        (&self.pattern, &self.values, &mut self.chol)
     }
 
     /// Copies the unknowns of each representative to the nodes tied to it.

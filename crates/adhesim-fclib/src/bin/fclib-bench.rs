@@ -126,14 +126,7 @@ fn nsgs_dense(p: &ReducedProblem, del: &Delassus, tol: f64, max_iter: usize) -> 
             twins: Vec::new(),
         })
         .collect();
-    let laws: Vec<InterfaceLaw> =
-        p.mu.iter()
-            .map(|&mu| InterfaceLaw {
-                mu,
-                adhesion: None,
-                anisotropy: None,
-            })
-            .collect();
+    let laws: Vec<InterfaceLaw> = p.mu.iter().map(|&mu| InterfaceLaw::coulomb(mu)).collect();
     let bond0 = vec![BondState::default(); n];
     let mut r = vec![[0.0; 3]; n];
     let mut x = vec![[0.0; 3]; n];
@@ -165,6 +158,21 @@ fn solve(name: &str, p: &ReducedProblem, del: &Delassus, o: &Options) -> Reduced
             proximal_newton(&p.w, &p.q, &p.mu, &r0, o.tol, o.max_iter.min(MAX_NEWTON)).0
         }
         _ => unreachable!("solver names are checked when parsing; global-newton is run apart"),
+    }
+}
+
+/// Runs `f` up to `runs` times (once more only while a run takes less than [`LONG_RUN`]);
+/// the last result and the wall time of each run [s].
+fn timed<T>(runs: usize, mut f: impl FnMut() -> T) -> (T, Vec<f64>) {
+    let mut times = Vec::new();
+    loop {
+        let t = Instant::now();
+        let result = f();
+        let dt = t.elapsed().as_secs_f64();
+        times.push(dt);
+        if times.len() >= runs.max(1) || dt > LONG_RUN {
+            return (result, times);
+        }
     }
 }
 
@@ -223,61 +231,33 @@ fn main() -> ExitCode {
             m: 3 * problem.w.points(),
         };
         for solver in &o.solvers {
-            if solver == "global-newton" {
+            // The global form is timed from M and H on, so without the condensation.
+            let (sol, times, condensed) = if solver == "global-newton" {
                 let Problem::Global(global) = &file.problem else {
                     continue;
                 };
-                let mut times = Vec::new();
-                let mut last = None;
-                for _ in 0..o.runs {
-                    let t = Instant::now();
-                    let sol = solve_global(global, o.tol, o.max_iter.min(MAX_NEWTON));
-                    let dt = t.elapsed().as_secs_f64();
-                    times.push(dt);
-                    last = Some(sol);
-                    if dt > LONG_RUN {
-                        break;
-                    }
-                }
-                match last.expect("at least one run") {
-                    Ok(sol) => println!(
-                        "{name},{kind},{},{solver},{},{:.3e},{},{:.4},{},",
-                        file.contacts(),
-                        sol.converged,
-                        sol.error,
-                        sol.iterations,
-                        1e3 * median(times.clone()),
-                        times.len()
-                    ),
-                    Err(e) => {
-                        eprintln!("fclib-bench: {path}: {solver}: {e}");
-                        failed = true;
-                    }
-                }
-                continue;
-            }
-            let mut times = Vec::new();
-            let mut last = None;
-            for _ in 0..o.runs {
-                let t = Instant::now();
-                let sol = solve(solver, &problem, &del, &o);
-                let dt = t.elapsed().as_secs_f64();
-                times.push(dt);
-                last = Some(sol);
-                if dt > LONG_RUN {
-                    break;
+                let max_iter = o.max_iter.min(MAX_NEWTON);
+                let (sol, times) = timed(o.runs, || solve_global(global, o.tol, max_iter));
+                (sol, times, "")
+            } else {
+                let (sol, times) = timed(o.runs, || solve(solver, &problem, &del, &o));
+                (Ok(sol), times, condense_ms.as_str())
+            };
+            match sol {
+                Ok(sol) => println!(
+                    "{name},{kind},{},{solver},{},{:.3e},{},{:.4},{},{condensed}",
+                    file.contacts(),
+                    sol.converged,
+                    sol.error,
+                    sol.iterations,
+                    1e3 * median(times.clone()),
+                    times.len()
+                ),
+                Err(e) => {
+                    eprintln!("fclib-bench: {path}: {solver}: {e}");
+                    failed = true;
                 }
             }
-            let sol = last.expect("at least one run");
-            println!(
-                "{name},{kind},{},{solver},{},{:.3e},{},{:.4},{},{condense_ms}",
-                file.contacts(),
-                sol.converged,
-                sol.error,
-                sol.iterations,
-                1e3 * median(times.clone()),
-                times.len()
-            );
         }
     }
     if failed {

@@ -128,6 +128,15 @@ pub struct InterfaceLaw {
 }
 
 impl InterfaceLaw {
+    /// Dry isotropic Coulomb friction with coefficient `mu` [-]: no adhesion, no anisotropy.
+    pub fn coulomb(mu: f64) -> Self {
+        InterfaceLaw {
+            mu,
+            adhesion: None,
+            anisotropy: None,
+        }
+    }
+
     /// The scale s = μ₂/μ₁ of the second tangential axis that maps the law's cone on the
     /// circular cone of μ₁ ([`super::anisotropic`]): 1 for an isotropic law (and for μ₁ = μ₂).
     pub fn tangent_scale(&self) -> f64 {
@@ -244,6 +253,18 @@ pub fn bipotential_trial(r_dry: [f64; 3], x: [f64; 3], mu: f64, rho: f64) -> [f6
         r_dry[1] - rho * x[1],
         r_dry[2] - rho * (x[2] + mu * xt),
     ]
+}
+
+/// D = ∂x̂/∂x of the modified relative displacement x̂ = x + μ‖x_t‖n at `x` [m] with the
+/// friction coefficient `mu` ≥ 0: I + μ n (x_t/‖x_t‖, 0)ᵀ, the second term dropped at x_t = 0.
+pub fn modified_displacement_jacobian(x: [f64; 3], mu: f64) -> [[f64; 3]; 3] {
+    let mut d = identity();
+    let xt = norm2(x[0], x[1]);
+    if xt > 0.0 && mu > 0.0 {
+        d[2][0] = mu * x[0] / xt;
+        d[2][1] = mu * x[1] / xt;
+    }
+    d
 }
 
 /// Intensity of adhesion at the end of a step of `dt` [s] from `beta0`, by implicit Euler of
@@ -1098,13 +1119,7 @@ fn newton_step(ctx: &Ctx, ev: &Eval) -> Option<V3> {
         }
     }
     let we = solve3_mat(m, p.w_aa)?;
-    let mut g = identity();
-    let xt = norm2(ev.x[0], ev.x[1]);
-    if xt > 0.0 && ctx.mu > 0.0 {
-        g[2][0] = ctx.mu * ev.x[0] / xt;
-        g[2][1] = ctx.mu * ev.x[1] / xt;
-    }
-    let gw = matmul(g, we);
+    let gw = matmul(modified_displacement_jacobian(ev.x, ctx.mu), we);
     let mut a = identity();
     for i in 0..3 {
         for j in 0..3 {

@@ -27,30 +27,23 @@
 //! regularisation (x + η r in place of x), which keeps the matrix regular when sticking points
 //! are more than the unknowns can satisfy, and vanishes as the residual does.
 
-use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
+use faer::sparse::{Pair, SymbolicSparseColMat};
 
 use super::anisotropic::{scale, unscale};
 use super::law::{
-    adhesive_response, bipotential_trial, dry_projection, projection_jacobian, BondState,
-    InterfaceLaw, PointSolution,
+    adhesive_response, bipotential_trial, dry_projection, modified_displacement_jacobian,
+    projection_jacobian, BondState, InterfaceLaw, PointSolution,
 };
+use super::semismooth::{ARMIJO, ETA_DOWN, ETA_MAX, ETA_MIN, ETA_START, ETA_UP};
 use crate::linalg::{metis_dof_ordering, BlockPattern};
 use crate::sparse_lu::OrderedLu;
 use crate::Mat3;
 
 type V3 = [f64; 3];
 
-/// Armijo constant σ of the line search on θ = ½‖Φ‖².
-const ARMIJO: f64 = 1e-4;
-/// Shortest step length the line search tries.
+/// Shortest step length the line search tries (the Armijo constant and the regularisation's
+/// schedule, η relative to the mean 1/ρ, are those of [`super::semismooth`]).
 const MIN_STEP: f64 = 1.0 / 1024.0;
-/// Proximal regularisation η relative to 1/ρ: its start, bounds and the factors applied after
-/// a full step and after a shortened or failed one (as in [`super::semismooth`]).
-const ETA_START: f64 = 1e-2;
-const ETA_MIN: f64 = 1e-12;
-const ETA_MAX: f64 = 1.0;
-const ETA_DOWN: f64 = 0.1;
-const ETA_UP: f64 = 10.0;
 /// Relative round-off of the natural map: the solve stops once the measure is below this
 /// fraction of the forces' norm, whatever the tolerance asked.
 const ROUND_OFF: f64 = 1e-13;
@@ -101,13 +94,8 @@ pub fn linearise_point(
     let (proj, state) = dry_projection(r_star, mu);
     let pj = projection_jacobian(r_star, mu, state);
     let pj = Mat3::from_fn(|i, j| pj[i][j]);
-    // D = ∂(x + μ‖x_t‖n)/∂x = I + μ n (x_t/‖x_t‖, 0)ᵀ, the second term dropped at x_t = 0.
-    let mut d = Mat3::identity();
-    let st = xs[0].hypot(xs[1]);
-    if st > 0.0 && mu > 0.0 {
-        d[(2, 0)] = mu * xs[0] / st;
-        d[(2, 1)] = mu * xs[1] / st;
-    }
+    let d = modified_displacement_jacobian(xs, mu);
+    let d = Mat3::from_fn(|i, j| d[i][j]);
     let t = Mat3::from_diagonal(&scale([1.0; 3], s).into());
     let t_inv = Mat3::from_diagonal(&unscale([1.0; 3], s).into());
     let a = t * (Mat3::identity() - pj) * t_inv;
@@ -132,6 +120,25 @@ pub fn linearise_point(
     }
 }
 
+/// H_α v for a point whose H is listed as (unknown, coefficients of the three local
+/// components).
+pub fn apply_h_terms(h: &[(usize, V3)], v: &[f64]) -> V3 {
+    let mut out = [0.0; 3];
+    for &(i, c) in h {
+        for k in 0..3 {
+            out[k] += c[k] * v[i];
+        }
+    }
+    out
+}
+
+/// Adds H_αᵀ f to `out`, H_α listed as in [`apply_h_terms`].
+pub fn add_ht_terms(h: &[(usize, V3)], f: V3, out: &mut [f64]) {
+    for &(i, c) in h {
+        out[i] += c[0] * f[0] + c[1] * f[1] + c[2] * f[2];
+    }
+}
+
 /// K̄ (symmetric, upper triangle in compressed columns) and H of the mixed system.
 pub struct MixedOperator<'a> {
     /// Column pointers of K̄'s upper triangle (n + 1).
@@ -152,13 +159,7 @@ impl MixedOperator<'_> {
 
     /// H_α v for point `p`.
     pub fn apply_h(&self, p: usize, v: &[f64]) -> V3 {
-        let mut out = [0.0; 3];
-        for &(i, c) in &self.h[p] {
-            for k in 0..3 {
-                out[k] += c[k] * v[i];
-            }
-        }
-        out
+        apply_h_terms(&self.h[p], v)
     }
 
     /// The mixed matrix's entries in a fixed order (K̄, then point by point −Hᵀ, B H and
@@ -208,8 +209,11 @@ impl MixedOperator<'_> {
 /// joined to the nodes it reads), made once and reused while the pattern stays.
 pub struct MixedPattern {
     entries: Vec<Pair<usize, usize>>,
-    symbolic: SymbolicSparseColMat<usize>,
-    order: Argsort<usize>,
+    /// Position of each listed entry among the compressed columns' values (repeated entries
+    /// share one).
+    slot: Vec<usize>,
+    /// The compressed columns' values, summed from the entries.
+    values: Vec<f64>,
     lu: OrderedLu,
 }
 
@@ -218,8 +222,17 @@ impl MixedPattern {
         let fail = |e: &dyn std::fmt::Debug| format!("mixed contact matrix analysis: {e:?}");
         let (n, m) = (op.n(), op.h.len());
         let dim = n + 3 * m;
-        let (symbolic, order) =
+        let (symbolic, _) =
             SymbolicSparseColMat::try_new_from_indices(dim, dim, &entries).map_err(|e| fail(&e))?;
+        let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
+        let slot = entries
+            .iter()
+            .map(|e| {
+                let start = col_ptr[e.col];
+                let rows = &row_idx[start..col_ptr[e.col + 1]];
+                start + rows.binary_search(&e.row).expect("entry in its column")
+            })
+            .collect();
         let nodes = n / 3;
         let mut nbrs: Vec<Vec<usize>> = vec![Vec::new(); nodes + m];
         for j in 0..n {
@@ -237,17 +250,13 @@ impl MixedPattern {
         }
         let graph = BlockPattern::from_neighbours(nodes + m, nbrs);
         let (fwd, inv) = metis_dof_ordering(&graph).map_err(|e| fail(&e))?;
-        let lu = OrderedLu::analyse(
-            symbolic.col_ptr().to_vec(),
-            symbolic.row_idx().to_vec(),
-            fwd,
-            inv,
-        )
-        .map_err(|e| fail(&e))?;
+        let values = vec![0.0; row_idx.len()];
+        let lu = OrderedLu::analyse(col_ptr.to_vec(), row_idx.to_vec(), fwd, inv)
+            .map_err(|e| fail(&e))?;
         Ok(MixedPattern {
             entries,
-            symbolic,
-            order,
+            slot,
+            values,
             lu,
         })
     }
@@ -255,11 +264,11 @@ impl MixedPattern {
     /// Solves the matrix with `values` (in the analysed order) against `rhs` in place; false
     /// if the factorisation fails or the solution is not finite.
     fn solve(&mut self, values: &[f64], rhs: &mut [f64]) -> bool {
-        let Ok(mat) = SparseColMat::new_from_argsort(self.symbolic.clone(), &self.order, values)
-        else {
-            return false;
-        };
-        if self.lu.factorise(mat.val()).is_err() {
+        self.values.iter_mut().for_each(|v| *v = 0.0);
+        for (&q, v) in self.slot.iter().zip(values) {
+            self.values[q] += v;
+        }
+        if self.lu.factorise(&self.values).is_err() {
             return false;
         }
         self.lu.solve_in_place(rhs);
@@ -520,11 +529,7 @@ mod tests {
             damage: 0.0,
         };
         let laws = [
-            InterfaceLaw {
-                mu: 0.3,
-                adhesion: None,
-                anisotropy: None,
-            },
+            InterfaceLaw::coulomb(0.3),
             InterfaceLaw {
                 mu: 0.5,
                 adhesion: Some(rcc),
@@ -624,11 +629,7 @@ mod tests {
             // nalgebra is column-major and W symmetric: the slice is W row-major too.
             let (reference, _) = semismooth_newton(&wd, &x0, &mu, &vec![[0.0; 3]; m], 1e-12, 100);
             assert!(reference.converged);
-            let law = InterfaceLaw {
-                mu: 0.3,
-                adhesion: None,
-                anisotropy: None,
-            };
+            let law = InterfaceLaw::coulomb(0.3);
             let rho: Vec<f64> = (0..m).map(|p| 1.0 / w[(3 * p + 2, 3 * p + 2)]).collect();
             let op = MixedOperator {
                 col_ptr: &col_ptr,

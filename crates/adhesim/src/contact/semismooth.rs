@@ -35,7 +35,9 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{Argsort, Pair, SparseColMat, SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Spec};
 
-use super::law::{bipotential_trial, dry_projection, projection_jacobian};
+use super::law::{
+    bipotential_trial, dry_projection, modified_displacement_jacobian, projection_jacobian,
+};
 use super::natural_map::{natural_map_residual, relative_error};
 use super::reduced::{gauss_seidel_sweep, point_rhos, BlockSparseDelassus, ReducedSolution};
 
@@ -45,14 +47,14 @@ type M3 = [[f64; 3]; 3];
 /// on all five (1 stalls on spheres-in-a-box near 2e-6; 10 stalls on Capsules near 1e-6).
 const RHO_FACTOR: f64 = 3.0;
 /// Armijo constant σ of the line search.
-const ARMIJO: f64 = 1e-4;
+pub(super) const ARMIJO: f64 = 1e-4;
 /// Regularisation η of the Newton matrix, relative to the mean of 1/ρ_α: its start,
 /// bounds, and the factors applied after a full step and after a shortened or failed one.
-const ETA_START: f64 = 1e-2;
-const ETA_MIN: f64 = 1e-12;
-const ETA_MAX: f64 = 1.0;
-const ETA_DOWN: f64 = 0.1;
-const ETA_UP: f64 = 10.0;
+pub(super) const ETA_START: f64 = 1e-2;
+pub(super) const ETA_MIN: f64 = 1e-12;
+pub(super) const ETA_MAX: f64 = 1.0;
+pub(super) const ETA_DOWN: f64 = 0.1;
+pub(super) const ETA_UP: f64 = 10.0;
 /// Largest Newton matrix (rows) factorised as a dense matrix rather than a sparse one.
 const DENSE_MAX: usize = 48;
 /// Smallest step length tried before a Gauss–Seidel sweep is taken instead.
@@ -174,13 +176,7 @@ fn newton_direction(
         let r_star = bipotential_trial(r[p], x[p], mu_p, rho[p]);
         let (_, case) = dry_projection(r_star, mu_p);
         let jp = projection_jacobian(r_star, mu_p, case);
-        // D = I + μ n (x_t/‖x_t‖, 0)ᵀ.
-        let mut d: M3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-        let st = x[p][0].hypot(x[p][1]);
-        if st > 0.0 && mu_p > 0.0 {
-            d[2][0] = mu_p * x[p][0] / st;
-            d[2][1] = mu_p * x[p][1] / st;
-        }
+        let d = modified_displacement_jacobian(x[p], mu_p);
         // ρ P' D.
         let mut pd: M3 = [[0.0; 3]; 3];
         for a in 0..3 {

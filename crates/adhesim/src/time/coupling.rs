@@ -161,14 +161,18 @@ pub trait ContactCoupling<'a> {
     /// The candidates and shared data of the step.
     fn step_contact(&mut self) -> &mut StepContact<'a>;
     /// Evaluates the contact forces at the iterate `u` (before the convergence check); may
-    /// replace `u` by a shorter step.
-    fn evaluate(&mut self, it: &Iterate, u: &mut [f64], timings: &mut PhaseTimes) -> Evaluated;
+    /// replace `u` by a shorter step. The solves that find the forces in [`Self::correct`]
+    /// have nothing to do here.
+    fn evaluate(&mut self, _it: &Iterate, _u: &mut [f64], _timings: &mut PhaseTimes) -> Evaluated {
+        Evaluated::Ready
+    }
     /// The contact forces Hᵀr on the free unknowns at the iterate [N].
     fn contact_force(&self) -> &[f64];
     /// The contact residual of the iterate relative to the force scale `scale` [N].
     fn contact_residual(&self, scale: f64) -> f64;
-    /// Adds the contact conditions' stiffness to K̄ (before its factorisation).
-    fn add_tangent(&self, system: &mut SystemMatrix);
+    /// Adds the contact conditions' stiffness to K̄ (before its factorisation); nothing for
+    /// the solves that keep K̄ as it is.
+    fn add_tangent(&self, _system: &mut SystemMatrix) {}
     /// Completes the Newton correction `du` solved from K̄ du = Hᵀr − G.
     #[allow(clippy::too_many_arguments)]
     fn correct(

@@ -3,7 +3,7 @@
 //! solved point by point and the correction completed by K̄⁻¹Hᵀ(r − r_prev). W is kept
 //! between steps and reused while it is still accurate.
 
-use super::coupling::{ContactCoupling, Evaluated, Iterate, StepContact};
+use super::coupling::{ContactCoupling, Iterate, StepContact};
 use super::integrator::norm;
 use super::PhaseTimes;
 use crate::contact::detect::ContactPoint;
@@ -139,10 +139,6 @@ impl<'a> ContactCoupling<'a> for DelassusCoupling<'a> {
         &mut self.sc
     }
 
-    fn evaluate(&mut self, _: &Iterate, _: &mut [f64], _: &mut PhaseTimes) -> Evaluated {
-        Evaluated::Ready
-    }
-
     fn contact_force(&self) -> &[f64] {
         &self.contact_force
     }
@@ -150,8 +146,6 @@ impl<'a> ContactCoupling<'a> for DelassusCoupling<'a> {
     fn contact_residual(&self, _scale: f64) -> f64 {
         self.contact_residual
     }
-
-    fn add_tangent(&self, _: &mut SystemMatrix) {}
 
     fn correct(
         &mut self,

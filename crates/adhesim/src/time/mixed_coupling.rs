@@ -6,17 +6,17 @@
 //! points' condensed blocks and GMRES ([`CondensedDirection`]). Its factorisations are counted
 //! in the contact phase (`time_contact_solve`), not in `time_factorisation`.
 
-use super::coupling::{ContactCoupling, Evaluated, Iterate, StepContact};
+use super::coupling::{ContactCoupling, Iterate, StepContact};
 use super::PhaseTimes;
 use crate::contact::detect::ContactPoint;
 use crate::contact::law::PointSolution;
 use crate::contact::mixed::{
-    linearise_point, solve_mixed, Direction, LuDirection, MixedDirection, MixedOperator,
-    MixedPattern, MixedWorkspace, PointLinearisation,
+    add_ht_terms, apply_h_terms, linearise_point, solve_mixed, Direction, LuDirection,
+    MixedDirection, MixedOperator, MixedPattern, MixedWorkspace, PointLinearisation,
 };
 use crate::contact::newton::add_contact_tangent;
 use crate::contact::newton::RHO_FACTOR;
-use crate::linalg::{gmres, BlockPattern};
+use crate::linalg::gmres;
 use crate::system::SystemMatrix;
 use crate::Mat3;
 use std::time::Instant;
@@ -110,13 +110,21 @@ pub fn point_h(pt: &ContactPoint, rep: &[usize], fixed: &[bool]) -> Vec<(usize, 
     merged
 }
 
+/// x_α + H_α v for each point, from the local displacements `x` [m] and a global field `v`.
+fn plus_h(points: &[ContactPoint], x: impl Iterator<Item = [f64; 3]>, v: &[f64]) -> Vec<[f64; 3]> {
+    points
+        .iter()
+        .zip(x)
+        .map(|(pt, x)| {
+            let h = pt.apply_h(v);
+            std::array::from_fn(|k| x[k] + h[k])
+        })
+        .collect()
+}
+
 impl<'a> ContactCoupling<'a> for MixedCoupling<'a> {
     fn step_contact(&mut self) -> &mut StepContact<'a> {
         &mut self.sc
-    }
-
-    fn evaluate(&mut self, _: &Iterate, _: &mut [f64], _: &mut PhaseTimes) -> Evaluated {
-        Evaluated::Ready
     }
 
     fn contact_force(&self) -> &[f64] {
@@ -126,8 +134,6 @@ impl<'a> ContactCoupling<'a> for MixedCoupling<'a> {
     fn contact_residual(&self, _scale: f64) -> f64 {
         self.contact_residual
     }
-
-    fn add_tangent(&self, _: &mut SystemMatrix) {}
 
     fn correct(
         &mut self,
@@ -149,14 +155,8 @@ impl<'a> ContactCoupling<'a> for MixedCoupling<'a> {
             self.h = sc.points.iter().map(|p| point_h(p, rep, fixed)).collect();
         }
         // The reduced problem's start: x at the forces r_prev the correction du was solved with.
-        let x0: Vec<[f64; 3]> = sc
-            .points
-            .iter()
-            .map(|pt| {
-                let (x, h) = (pt.local_x(sc.reference, u), pt.apply_h(du));
-                std::array::from_fn(|k| x[k] + h[k])
-            })
-            .collect();
+        let x_now = sc.points.iter().map(|pt| pt.local_x(sc.reference, u));
+        let x0 = plus_h(&sc.points, x_now, du);
         let rho: Vec<f64> = sc
             .rho
             .iter()
@@ -170,14 +170,12 @@ impl<'a> ContactCoupling<'a> for MixedCoupling<'a> {
             linearise_point(law, sc.bond0[p], sc.dt, pt.area, rho[p], r, x)
         };
         let measure = |pts: &[PointSolution]| sc.natural_map(pts);
-        // K̄ as the Newton loop factorised it, and the pattern for products with it.
+        // K̄ as the Newton loop factorised it, restored before each direction's factorisation.
         let base = system.factorised_matrix().1.to_vec();
-        let pattern = system.pattern().clone();
         let mut solve = |system: &mut SystemMatrix, r0: &[[f64; 3]], x0: &[[f64; 3]]| {
             let mut dir = CondensedDirection {
                 system,
                 base: &base,
-                pattern: &pattern,
                 points: &sc.points,
                 h,
                 lu: &mut self.workspace.pattern,
@@ -196,15 +194,7 @@ impl<'a> ContactCoupling<'a> for MixedCoupling<'a> {
             system.factorise().map_err(|e| e.to_string())?;
             let mut d0 = sc.nodal_force(self.r_contact.iter().map(|r| r.map(|v| -v)), u.len());
             system.solve_in_place(&mut d0);
-            let x0: Vec<[f64; 3]> = sc
-                .points
-                .iter()
-                .zip(&x0)
-                .map(|(pt, x)| {
-                    let h = pt.apply_h(&d0);
-                    std::array::from_fn(|k| x[k] + h[k])
-                })
-                .collect();
+            let x0 = plus_h(&sc.points, x0.iter().copied(), &d0);
             let zeros = vec![[0.0; 3]; x0.len()];
             let again = solve(system, &zeros, &x0)?;
             iterations += again.iterations;
@@ -234,7 +224,8 @@ impl<'a> ContactCoupling<'a> for MixedCoupling<'a> {
         self.r_contact = sol.r;
         self.contact_force = self.sc.nodal_force(self.r_contact.iter().copied(), u.len());
         self.solutions = sol.points;
-        self.contact_residual = self.sc.natural_map(&self.solutions) / scale;
+        // The solve's measure is the step's natural map.
+        self.contact_residual = sol.residual / scale;
         Ok(())
     }
 
@@ -277,27 +268,10 @@ const LU_FALLBACK_MAX: usize = 60_000;
 struct CondensedDirection<'s> {
     system: &'s mut SystemMatrix,
     base: &'s [f64],
-    pattern: &'s BlockPattern,
     points: &'s [ContactPoint],
     h: &'s [Vec<(usize, [f64; 3])>],
     /// The LU analysis of the whole mixed matrix, for directions GMRES cannot find.
     lu: &'s mut Option<MixedPattern>,
-}
-
-/// H_α v from a point's list of (unknown, coefficients).
-fn apply_h(h: &[(usize, [f64; 3])], v: &[f64]) -> nalgebra::Vector3<f64> {
-    let mut out = nalgebra::Vector3::zeros();
-    for &(i, c) in h {
-        out += nalgebra::Vector3::from(c) * v[i];
-    }
-    out
-}
-
-/// Adds H_αᵀ f to `out`.
-fn add_ht(h: &[(usize, [f64; 3])], f: &nalgebra::Vector3<f64>, out: &mut [f64]) {
-    for &(i, c) in h {
-        out[i] += c[0] * f[0] + c[1] * f[1] + c[2] * f[2];
-    }
 }
 
 /// The positive part of the symmetric part of `s`.
@@ -309,7 +283,7 @@ fn positive_symmetric_part(s: &Mat3) -> Mat3 {
 
 impl MixedDirection for CondensedDirection<'_> {
     fn unknowns(&self) -> usize {
-        self.pattern.dim()
+        self.system.pattern().dim()
     }
 
     fn eta_floor(&self) -> f64 {
@@ -347,11 +321,10 @@ impl MixedDirection for CondensedDirection<'_> {
         if self.system.factorise().is_err() {
             return Ok(None);
         }
-        let n = self.pattern.dim();
-        let values = self.system.factorised_matrix().1.to_vec();
+        let n = self.unknowns();
         let mut rhs = vec![0.0; n];
         for (h, ga) in self.h.iter().zip(&g) {
-            add_ht(h, &(-ga), &mut rhs);
+            add_ht_terms(h, (-ga).into(), &mut rhs);
         }
         // The part of S the preconditioner leaves out.
         let rest: Vec<Mat3> = s
@@ -359,18 +332,19 @@ impl MixedDirection for CondensedDirection<'_> {
             .zip(&positive)
             .map(|(sa, p)| sa - Mat3::from_fn(|i, j| p[i][j]))
             .collect();
-        let (pattern, h) = (self.pattern, self.h);
+        let h = self.h;
+        let (pattern, values, factor) = self.system.operator_and_factor();
         let apply = |v: &[f64], out: &mut [f64]| {
             out.iter_mut().for_each(|o| *o = 0.0);
-            pattern.symmetric_matvec(&values, v, out);
+            pattern.symmetric_matvec(values, v, out);
             for (ha, ra) in h.iter().zip(&rest) {
                 if ra.iter().any(|&e| e != 0.0) {
-                    add_ht(ha, &(ra * apply_h(ha, v)), out);
+                    let hv = nalgebra::Vector3::from(apply_h_terms(ha, v));
+                    add_ht_terms(ha, (ra * hv).into(), out);
                 }
             }
         };
-        let system = &mut *self.system;
-        let precondition = |v: &mut [f64]| system.solve_condensed(v);
+        let precondition = |v: &mut [f64]| factor.solve_in_place(v);
         let (du, outcome) = gmres(
             apply,
             precondition,
@@ -385,9 +359,10 @@ impl MixedDirection for CondensedDirection<'_> {
             if n + 3 * m > LU_FALLBACK_MAX {
                 return Ok(None);
             }
+            let pattern = self.system.pattern();
             let op = MixedOperator {
-                col_ptr: &self.pattern.col_ptr,
-                row_idx: &self.pattern.row_idx,
+                col_ptr: &pattern.col_ptr,
+                row_idx: &pattern.row_idx,
                 values: self.base,
                 h: self.h,
             };
@@ -397,14 +372,13 @@ impl MixedDirection for CondensedDirection<'_> {
             };
             return lu.direction(lin, eta);
         }
-        let x: Vec<nalgebra::Vector3<f64>> = self.h.iter().map(|ha| apply_h(ha, &du)).collect();
+        let x: Vec<[f64; 3]> = self.h.iter().map(|ha| apply_h_terms(ha, &du)).collect();
         let d = s
             .iter()
             .zip(&g)
             .zip(&x)
-            .map(|((sa, ga), xa)| (-ga - sa * xa).into())
+            .map(|((sa, ga), &xa)| (-ga - sa * nalgebra::Vector3::from(xa)).into())
             .collect();
-        let x = x.into_iter().map(Into::into).collect();
         Ok(Some(Direction { du, d, x }))
     }
 }
