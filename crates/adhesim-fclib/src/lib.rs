@@ -610,6 +610,7 @@ pub fn solve_global(
     let mut dir = LuDirection {
         op: &op,
         pattern: &mut pattern,
+        momentum: &[],
     };
     let mut eta_rel = 1e-2;
     let r0 = vec![[0.0; 3]; nc];

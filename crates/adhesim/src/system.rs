@@ -146,6 +146,13 @@ impl SystemMatrix {
     /// Applies the Dirichlet conditions and the ties (zero fixed rows and columns, a positive
     /// diagonal) and factorises.
     pub fn factorise(&mut self) -> Result<(), LinalgError> {
+        self.apply_conditions();
+        self.chol.factorise(&self.values)
+    }
+
+    /// Applies the Dirichlet conditions and the ties to the values, as [`Self::factorise`]
+    /// does before it factorises.
+    pub fn apply_conditions(&mut self) {
         for &q in &self.zero_positions {
             self.values[q] = 0.0;
         }
@@ -157,7 +164,23 @@ impl SystemMatrix {
                 }
             }
         }
-        self.chol.factorise(&self.values)
+    }
+
+    /// Moves a right-hand side `rhs` (all unknowns) onto the factorised system's unknowns:
+    /// a tied node's part is added to its representative's (as [`Self::solve_in_place`]
+    /// does), and the fixed unknowns' parts are set to zero.
+    pub fn condense(&self, rhs: &mut [f64]) {
+        for &(t, r) in &self.tied_nodes {
+            for k in 0..3 {
+                rhs[3 * r + k] += rhs[3 * t + k];
+                rhs[3 * t + k] = 0.0;
+            }
+        }
+        for (v, &fixed) in rhs.iter_mut().zip(&self.fixed) {
+            if fixed {
+                *v = 0.0;
+            }
+        }
     }
 
     /// The matrix last factorised: its pattern (upper triangle) and values, with the

@@ -309,7 +309,8 @@ pub struct MixedSolution {
     pub r: Vec<V3>,
     /// Each point's law at the solution.
     pub points: Vec<PointSolution>,
-    /// Change of the unknowns δu = K̄⁻¹Hᵀ(r − r₀) [m].
+    /// Change of the unknowns δu = K̄⁻¹(Hᵀ(r − r₀) + m) [m], m the direction's out-of-balance
+    /// force ([`MixedDirection::momentum_norm`]; zero for most).
     pub du: Vec<f64>,
     /// The caller's measure of the residual at the end [N].
     pub residual: f64,
@@ -338,12 +339,19 @@ pub trait MixedDirection {
     fn eta_floor(&self) -> f64 {
         ETA_MIN
     }
-    /// The direction for the linearisations `lin` with regularisation `eta` [m/N]; `None`
-    /// when it cannot be computed (a singular matrix, values that are not finite).
+    /// The norm of the out-of-balance force m the directions also remove [N] (zero when the
+    /// displacement part has no right-hand side of its own).
+    fn momentum_norm(&self) -> f64 {
+        0.0
+    }
+    /// The direction for the linearisations `lin` with regularisation `eta` [m/N], of the
+    /// mixed system whose displacement part has the right-hand side `momentum` m; `None` when
+    /// it cannot be computed (a singular matrix, values that are not finite).
     fn direction(
         &mut self,
         lin: &[PointLinearisation],
         eta: f64,
+        momentum: f64,
     ) -> Result<Option<Direction>, String>;
 }
 
@@ -353,6 +361,8 @@ pub struct LuDirection<'a, 'b> {
     pub op: &'a MixedOperator<'b>,
     /// The LU analysis, redone when the entries differ.
     pub pattern: &'a mut Option<MixedPattern>,
+    /// The out-of-balance force m on the unknowns [N] (empty: none).
+    pub momentum: &'a [f64],
 }
 
 impl MixedDirection for LuDirection<'_, '_> {
@@ -360,10 +370,15 @@ impl MixedDirection for LuDirection<'_, '_> {
         self.op.n()
     }
 
+    fn momentum_norm(&self) -> f64 {
+        self.momentum.iter().map(|v| v * v).sum::<f64>().sqrt()
+    }
+
     fn direction(
         &mut self,
         lin: &[PointLinearisation],
         eta: f64,
+        momentum: f64,
     ) -> Result<Option<Direction>, String> {
         let (n, m) = (self.op.n(), lin.len());
         let (entries, values) = self.op.entries(lin, eta);
@@ -371,6 +386,9 @@ impl MixedDirection for LuDirection<'_, '_> {
             *self.pattern = Some(MixedPattern::new(self.op, entries)?);
         }
         let mut sol = vec![0.0; n + 3 * m];
+        for (v, f) in sol.iter_mut().zip(self.momentum) {
+            *v = momentum * f;
+        }
         for (p, l) in lin.iter().enumerate() {
             for k in 0..3 {
                 sol[n + 3 * p + k] = -l.phi[k];
@@ -393,8 +411,10 @@ impl MixedDirection for LuDirection<'_, '_> {
 /// [m]) until `measure` of the points' solutions is ≤ `tol` [N] or `max_iter` steps, with
 /// directions from `dir`; `law(p, r, x)` linearises point p's law with its natural-map
 /// parameter `rho[p]` [N/m]. `measure` is the caller's residual (e.g. the natural map with
-/// another ρ; Φ's norm with these ρ is the merit of the line search). `eta_rel` carries the
-/// regularisation level from call to call.
+/// another ρ; Φ's norm with these ρ is the merit of the line search). A direction whose
+/// displacement part has an out-of-balance force m of its own removes it as well: what is
+/// left of it, s m with s = Π(1 − t) over the steps t taken, adds ½ (s ‖m‖)² to the merit and
+/// must be ≤ `tol` too. `eta_rel` carries the regularisation level from call to call.
 #[allow(clippy::too_many_arguments)]
 pub fn solve_mixed(
     dir: &mut impl MixedDirection,
@@ -423,6 +443,10 @@ pub fn solve_mixed(
     let mut du = vec![0.0; n];
     let (mut lin, mut theta) = eval(&r, &x);
     let (mut iterations, mut stalled, mut failed) = (0, false, false);
+    // The part of the out-of-balance force m still to remove: s m, with s = Π(1 − t) over
+    // the steps t taken. It enters the merit as ½ (s ‖m‖)².
+    let m_norm = dir.momentum_norm();
+    let mut s = 1.0;
     loop {
         let points: Vec<PointSolution> = lin.iter().map(|l| l.solution).collect();
         let measured = measure(&points);
@@ -430,17 +454,19 @@ pub fn solve_mixed(
         // is still zero (nothing loaded yet) cannot ask for less.
         let force = r.iter().flatten().map(|v| v * v).sum::<f64>().sqrt();
         let floor = ROUND_OFF * force;
-        if measured <= tol.max(floor) || iterations >= max_iter || stalled {
+        let converged = measured <= tol.max(floor) && s * m_norm <= tol.max(floor);
+        if converged || iterations >= max_iter || stalled {
             return Ok(MixedSolution {
                 r,
                 points,
                 du,
                 residual: measured,
                 iterations,
-                converged: measured <= tol.max(floor),
+                converged,
             });
         }
         let residual = (2.0 * theta).sqrt();
+        let momentum_merit = |s: f64| 0.5 * (s * m_norm).powi(2);
         iterations += 1;
         // The regularisation vanishes with the residual relative to the forces, unless the
         // last step failed (then it is raised).
@@ -451,7 +477,7 @@ pub fn solve_mixed(
         };
         let level = level.max(dir.eta_floor());
         let mut accepted = false;
-        if let Some(step) = dir.direction(&lin, eta_scale * level)? {
+        if let Some(step) = dir.direction(&lin, eta_scale * level, s)? {
             let mut t = 1.0;
             while t >= MIN_STEP {
                 let r_try: Vec<V3> = (0..m)
@@ -461,8 +487,10 @@ pub fn solve_mixed(
                     .map(|p| std::array::from_fn(|k| x[p][k] + t * step.x[p][k]))
                     .collect();
                 let (lin_try, theta_try) = eval(&r_try, &x_try);
-                if theta_try <= (1.0 - 2.0 * ARMIJO * t) * theta {
+                let merit = theta + momentum_merit(s);
+                if theta_try + momentum_merit((1.0 - t) * s) <= (1.0 - 2.0 * ARMIJO * t) * merit {
                     (r, x, lin, theta) = (r_try, x_try, lin_try, theta_try);
+                    s *= 1.0 - t;
                     for (u, dd) in du.iter_mut().zip(&step.du) {
                         *u += t * dd;
                     }
@@ -580,7 +608,8 @@ mod tests {
 
     /// The mixed solve on (K, H) finds the solution of the reduced problem on W = H K⁻¹ Hᵀ,
     /// q = x₀ (forces to 1e-8 of their size, both solved to 1e-12), and its δu is K⁻¹Hᵀr:
-    /// the same problem, without forming W.
+    /// the same problem, without forming W. With an out-of-balance force in the displacement
+    /// part, the same holds for the shifted start.
     #[test]
     fn mixed_solve_matches_the_reduced_problem() {
         for seed in 1..5u64 {
@@ -658,30 +687,51 @@ mod tests {
                 defects.flatten().map(|v| v * v).sum::<f64>().sqrt()
             };
             let r0 = vec![[0.0; 3]; m];
-            let mut dir = LuDirection {
-                op: &op,
-                pattern: &mut pattern,
-            };
-            let tol = 1e-12 * force;
-            let sol = solve_mixed(&mut dir, lin, phi, &rho, &r0, &x0, tol, 100, &mut eta_rel)
+            // Once as it is, once with an out-of-balance force m in the displacement part,
+            // started from x₀ − H K⁻¹m: the same linear model, so the same solution, with
+            // δu = K⁻¹(Hᵀr + m).
+            let m_force = nalgebra::DVector::from_fn(n, |_, _| rng.next_centered());
+            for momentum in [nalgebra::DVector::zeros(n), m_force] {
+                let shift = &hmat * &kinv * &momentum;
+                let start: Vec<V3> = (0..m)
+                    .map(|p| std::array::from_fn(|c| x0[p][c] - shift[3 * p + c]))
+                    .collect();
+                let mut dir = LuDirection {
+                    op: &op,
+                    pattern: &mut pattern,
+                    momentum: momentum.as_slice(),
+                };
+                let tol = 1e-12 * force;
+                let sol = solve_mixed(
+                    &mut dir,
+                    lin,
+                    phi,
+                    &rho,
+                    &r0,
+                    &start,
+                    tol,
+                    100,
+                    &mut eta_rel,
+                )
                 .expect("analysis");
-            assert!(sol.converged, "seed {seed}: residual {}", sol.residual);
-            for (a, b) in sol.r.iter().zip(&reference.r) {
-                for c in 0..3 {
+                assert!(sol.converged, "seed {seed}: residual {}", sol.residual);
+                for (a, b) in sol.r.iter().zip(&reference.r) {
+                    for c in 0..3 {
+                        assert!(
+                            (a[c] - b[c]).abs() <= 1e-8 * force,
+                            "seed {seed}: {a:?} vs {b:?}"
+                        );
+                    }
+                }
+                let r = nalgebra::DVector::from_iterator(3 * m, sol.r.iter().flatten().copied());
+                let du = &kinv * (hmat.transpose() * r + &momentum);
+                let du_norm = du.norm();
+                for (a, b) in sol.du.iter().zip(du.iter()) {
                     assert!(
-                        (a[c] - b[c]).abs() <= 1e-8 * force,
-                        "seed {seed}: {a:?} vs {b:?}"
+                        (a - b).abs() <= 1e-8 * du_norm,
+                        "seed {seed}: δu {a} vs {b}"
                     );
                 }
-            }
-            let r = nalgebra::DVector::from_iterator(3 * m, sol.r.iter().flatten().copied());
-            let du = &kinv * hmat.transpose() * r;
-            let du_norm = du.norm();
-            for (a, b) in sol.du.iter().zip(du.iter()) {
-                assert!(
-                    (a - b).abs() <= 1e-8 * du_norm,
-                    "seed {seed}: δu {a} vs {b}"
-                );
             }
             // Not a trivial case: some point carries a force.
             assert!(force > 0.0, "seed {seed}");

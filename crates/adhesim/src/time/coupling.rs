@@ -173,7 +173,9 @@ pub trait ContactCoupling<'a> {
     /// Adds the contact conditions' stiffness to K̄ (before its factorisation); nothing for
     /// the solves that keep K̄ as it is.
     fn add_tangent(&self, _system: &mut SystemMatrix) {}
-    /// Completes the Newton correction `du` solved from K̄ du = Hᵀr − G.
+    /// Completes the Newton correction `du` solved from K̄ du = Hᵀr − G; for a coupling that
+    /// [folds the momentum](Self::folds_momentum) in, `du` holds Hᵀr − G itself, K̄'s values
+    /// are set but not factorised, and `correct` replaces `du` by the whole correction.
     #[allow(clippy::too_many_arguments)]
     fn correct(
         &mut self,
@@ -185,6 +187,12 @@ pub trait ContactCoupling<'a> {
         system: &mut SystemMatrix,
         timings: &mut PhaseTimes,
     ) -> Result<(), String>;
+    /// Whether the coupling solves the momentum balance together with the contact law in
+    /// [`Self::correct`] (one factorisation of the coupled system per Newton iteration),
+    /// instead of completing a correction solved with K̄ alone.
+    fn folds_momentum(&self) -> bool {
+        false
+    }
     /// Per-point solutions at the iterate.
     fn solutions(&self) -> Vec<PointSolution>;
     /// Contact iterations so far (Gauss-Seidel sweeps or multiplier updates).

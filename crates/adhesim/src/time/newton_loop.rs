@@ -109,7 +109,11 @@ impl<'a> NewtonLoop<'a> {
         if iter == self.settings.max_newton {
             return Ok(Flow::Continue);
         }
-        let mut du = self.newton_correction(&asm.tangent, iter)?;
+        let mut du = if self.coupling.folds_momentum() {
+            self.out_of_balance(&asm.tangent)
+        } else {
+            self.newton_correction(&asm.tangent, iter)?
+        };
         let it = Iterate::new(iter, &self.ws.g, balance.potential);
         let (norm_g, scale) = (check.norm, check.scale);
         let timings = &mut self.timings;
@@ -151,6 +155,16 @@ impl<'a> NewtonLoop<'a> {
         self.system.solve_in_place(&mut du);
         self.timings.factorisation += clock.elapsed().as_secs_f64();
         Ok(du)
+    }
+
+    /// K̄'s values, with the conditions applied but not factorised, and the out-of-balance
+    /// force Hᵀr − G, for a coupling that solves both together.
+    fn out_of_balance(&mut self, tangent: &[f64]) -> Vec<f64> {
+        self.system.set_from_base(&self.step.matrix_terms(tangent));
+        self.coupling.add_tangent(self.system);
+        self.system.apply_conditions();
+        let force = self.coupling.contact_force();
+        force.iter().zip(&self.ws.g).map(|(r, g)| r - g).collect()
     }
 
     /// Stage *commit* (what the step hands back): the converged iterate `u` with its end
