@@ -148,13 +148,14 @@ impl InterfaceLaw {
     }
 }
 
-/// What the stepper needs from an interface law between the point solves: its history at a
-/// slave node ([`LawHistory`], named fields for the outputs and the checkpoints), the frozen
-/// history the point solvers take at the start of a step, the history to commit from a
-/// point's solution, and the force scale of its bonds.
+/// What the stepper and the contact solves need from an interface law besides its friction
+/// cone (μ, [`InterfaceLaw::tangent_scale`]): its history at a slave node ([`LawHistory`],
+/// named fields for the outputs and the checkpoints), the frozen history the point solvers
+/// take at the start of a step, the adhesive response at that history, the history to commit
+/// from a point's solution, and the force scale of its bonds.
 ///
-/// The point solvers themselves read the friction cone (μ, [`InterfaceLaw::tangent_scale`])
-/// and the adhesive force with its tangent at the frozen history from the law's parameters.
+/// The Gauss-Seidel point solver ([`solve_point`]) evaluates the RCC adhesion of the law's
+/// parameters directly (implicitly in x, with its own warm start).
 /// The RCC law, with dry Coulomb friction as its case without adhesion, implements it in
 /// `rcc.rs`; a law's history is registered in [`REGISTERED_HISTORIES`].
 pub trait Interface {
@@ -169,6 +170,19 @@ pub trait Interface {
     /// Largest quasi-static traction of the law's bonds [Pa] (0 without adhesion): times a
     /// point's area, the force its bond can carry.
     fn bond_traction(&self) -> f64;
+
+    /// The adhesive response at the local relative displacement `x` [m] of a point whose
+    /// history is frozen at `start`, over a step of `dt` [s], with tributary area `area` [m²]
+    /// (the force r̃, its secant stiffness, the incremental potential and the history it
+    /// leads to); None for a law without adhesion. The fclib Newton and the mixed solve
+    /// linearise the law with it.
+    fn adhesive_response(
+        &self,
+        start: &BondState,
+        dt: f64,
+        area: f64,
+        x: [f64; 3],
+    ) -> Option<AdhesiveResponse>;
 
     /// The frozen history at the start of a step of a point whose node history is `node`,
     /// in the point's local frame `frame` (rows t₁, t₂, n in global components).

@@ -8,7 +8,10 @@
 //! and its tangent, fatigue, orthotropy).
 
 use super::history::{FieldKind, HistoryField, LawHistory, NodeHistory, Slot};
-use super::law::{accumulated_damage, BondState, Interface, InterfaceLaw, PointSolution};
+use super::law::{
+    accumulated_damage, adhesive_response, AdhesiveResponse, BondState, Interface, InterfaceLaw,
+    PointSolution,
+};
 
 /// The history of the RCC law at a slave node, between steps.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -80,6 +83,18 @@ impl Interface for InterfaceLaw {
 
     fn bond_traction(&self) -> f64 {
         self.adhesion.map_or(0.0, |a| a.peak_traction())
+    }
+
+    fn adhesive_response(
+        &self,
+        start: &BondState,
+        dt: f64,
+        area: f64,
+        x: [f64; 3],
+    ) -> Option<AdhesiveResponse> {
+        self.adhesion
+            .as_ref()
+            .map(|a| adhesive_response(a, *start, dt, area, x))
     }
 
     fn point_history(&self, node: &NodeHistory, frame: &[[f64; 3]; 3]) -> BondState {
