@@ -156,6 +156,7 @@ impl InterfaceLaw {
 ///
 /// The Gauss-Seidel point solver ([`solve_point`]) evaluates the RCC adhesion of the law's
 /// parameters directly (implicitly in x, with its own warm start).
+///
 /// The RCC law, with dry Coulomb friction as its case without adhesion, implements it in
 /// `rcc.rs`; a law's history is registered in [`REGISTERED_HISTORIES`].
 pub trait Interface {
