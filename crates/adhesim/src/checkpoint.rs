@@ -13,6 +13,7 @@
 //! and last an FNV-1a 64 checksum of everything before it. The file is replaced atomically
 //! (see [`crate::output::atomic`]), so there is always one complete checkpoint: the last.
 
+use crate::contact::history::MAX_HISTORY_VALUES;
 use crate::output::FrameProgress;
 use crate::problem::Problem;
 use crate::time::{CachedDelassus, DelassusCache, NodeContact, Snapshot};
@@ -23,7 +24,10 @@ use std::path::{Path, PathBuf};
 pub const FILE_NAME: &str = "checkpoint.bin";
 
 const MAGIC: &[u8; 8] = b"ADHCKPT\0";
-const FORMAT: u32 = 4;
+const FORMAT: u32 = 5;
+/// The previous format, still read: it stored the RCC law's history (β, u_t, D), the only
+/// law then, among each contact node's other values.
+const FORMAT_RCC_ONLY: u32 = 4;
 
 /// A run's state after a committed step.
 #[derive(Clone, Debug, PartialEq)]
@@ -157,11 +161,18 @@ impl Checkpoint {
     /// The checkpoint as bytes (see the module documentation for the layout). It takes the
     /// checkpoint by value: [`Checkpoint::visit`], which reading shares, needs its fields
     /// mutable, and the caller has no further use for them.
-    pub fn encode(mut self) -> Vec<u8> {
+    pub fn encode(self) -> Vec<u8> {
+        self.encode_as(FORMAT)
+    }
+
+    /// [`Checkpoint::encode`] in the file format `format` ([`FORMAT`], or format 4 for the
+    /// tests that read it).
+    fn encode_as(mut self, format: u32) -> Vec<u8> {
         let mut w = Enc(Vec::new());
         w.0.extend_from_slice(MAGIC);
-        w.0.extend_from_slice(&FORMAT.to_le_bytes());
-        self.visit(&mut w).expect("writing to memory cannot fail");
+        w.0.extend_from_slice(&format.to_le_bytes());
+        self.visit(&mut w, format)
+            .expect("writing to memory cannot fail");
         let mut h = Fnv::new();
         h.update(&w.0);
         w.0.extend_from_slice(&h.0.to_le_bytes());
@@ -184,9 +195,10 @@ impl Checkpoint {
             pos: MAGIC.len(),
         };
         let format = u32::from_le_bytes(r.take(4)?.try_into().unwrap());
-        if format != FORMAT {
+        if format != FORMAT && format != FORMAT_RCC_ONLY {
             return Err(format!(
-                "format {format}, but this version of adhesim reads format {FORMAT}"
+                "format {format}, but this version of adhesim reads formats \
+                 {FORMAT_RCC_ONLY} and {FORMAT}"
             ));
         }
         let mut checkpoint = Checkpoint {
@@ -217,7 +229,7 @@ impl Checkpoint {
             newton_iterations: 0,
             wall_time: 0.0,
         };
-        checkpoint.visit(&mut r)?;
+        checkpoint.visit(&mut r, format)?;
         if r.pos != body.len() {
             return Err(format!(
                 "{} unexpected bytes after the last field",
@@ -228,8 +240,9 @@ impl Checkpoint {
     }
 
     /// Every field after the header, in file order, through `c`: the one list of fields that
-    /// both writing and reading follow.
-    fn visit(&mut self, c: &mut impl Codec) -> Result<(), String> {
+    /// both writing and reading follow. `format` is the file's (always [`FORMAT`] when
+    /// writing).
+    fn visit(&mut self, c: &mut impl Codec, format: u32) -> Result<(), String> {
         c.str(&mut self.version)?;
         c.u64(&mut self.fingerprint)?;
         let s = &mut self.snapshot;
@@ -245,7 +258,21 @@ impl Checkpoint {
         c.f64(&mut s.last_internal)?;
         c.count(&mut s.contact, 8)?;
         for nodes in &mut s.contact {
-            c.count(nodes, 8 * NodeContact::VALUES + 4)?;
+            if format == FORMAT_RCC_ONLY {
+                rcc_only_nodes(c, nodes)?;
+                continue;
+            }
+            // Per pair: how many history values each node holds, then per node its values,
+            // its state code and its history.
+            let mut stored = MAX_HISTORY_VALUES;
+            c.usize(&mut stored)?;
+            if stored > MAX_HISTORY_VALUES {
+                return Err(format!(
+                    "{stored} history values per contact node, more than the \
+                     {MAX_HISTORY_VALUES} this version of adhesim holds"
+                ));
+            }
+            c.count(nodes, 8 * (NodeContact::VALUES + stored) + 4)?;
             for node in nodes.iter_mut() {
                 let mut values = node.to_values();
                 for x in &mut values {
@@ -253,7 +280,11 @@ impl Checkpoint {
                 }
                 let mut state = node.state;
                 c.i32(&mut state)?;
-                *node = NodeContact::from_values(&values, state);
+                let mut history = node.history;
+                for x in &mut history.0[..stored] {
+                    c.f64(x)?;
+                }
+                *node = NodeContact::from_values(&values, state, history);
             }
         }
         c.f64s(&mut s.material_history)?;
@@ -271,6 +302,25 @@ impl Checkpoint {
         c.usize(&mut self.newton_iterations)?;
         c.f64(&mut self.wall_time)
     }
+}
+
+/// The contact nodes of a pair in format 4: per node β, u_t (3), then the
+/// [`NodeContact::to_values`], then D, then the state code. β, u_t and D are the first five
+/// values of the RCC law's history ([`crate::contact::RccHistory`]), in its order.
+fn rcc_only_nodes(c: &mut impl Codec, nodes: &mut Vec<NodeContact>) -> Result<(), String> {
+    c.count(nodes, 8 * (NodeContact::VALUES + 5) + 4)?;
+    for node in nodes.iter_mut() {
+        let mut history = node.history;
+        let mut values = node.to_values();
+        for x in history.0[..4].iter_mut().chain(&mut values) {
+            c.f64(x)?;
+        }
+        c.f64(&mut history.0[4])?;
+        let mut state = node.state;
+        c.i32(&mut state)?;
+        *node = NodeContact::from_values(&values, state, history);
+    }
+    Ok(())
 }
 
 /// The kept Delassus operator: a count (0 or 1), then its key, its frames and W.
@@ -413,12 +463,17 @@ impl Codec for Dec<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::contact::LawHistory;
     use crate::output::vtk::PvdEntry;
 
     fn sample() -> Checkpoint {
         let c = NodeContact {
-            beta: 0.25,
-            ut: [1e-9, -2e-9, 0.0],
+            history: crate::contact::RccHistory {
+                beta: 0.25,
+                ut: [1e-9, -2e-9, 0.0],
+                damage: 0.125,
+            }
+            .encode(),
             r_dry: [0.1, 0.2, -0.3],
             r_adh: [0.0, 0.0, 4.5],
             force: [1.0, 2.0, 3.0],
@@ -426,7 +481,6 @@ mod tests {
             slip: [1e-300, -0.0],
             state: 3,
             tangent_axes: [[1.0, 0.0, 0.0], [0.0, 1.0 / 3.0, 0.7]],
-            damage: 0.125,
         };
         Checkpoint {
             version: "0.1.0".into(),
@@ -483,6 +537,20 @@ mod tests {
         assert_eq!(d.snapshot.contact[0][0].tangent_axes[1][1], 1.0 / 3.0);
         assert_eq!(d.snapshot.u[1].to_bits(), (-0.0f64).to_bits());
         assert_eq!(d.frames.entries[0].file, "vtu/é_00000.vtu");
+    }
+
+    /// Format 4 (the RCC law's history among the node's values) is still read, to the same
+    /// checkpoint.
+    #[test]
+    fn format_4_is_read() {
+        let c = sample();
+        let old = c.clone().encode_as(FORMAT_RCC_ONLY);
+        assert_eq!(&old[8..12], &4u32.to_le_bytes());
+        assert_ne!(old, c.clone().encode());
+        let d = Checkpoint::decode(&old).unwrap();
+        assert!(bits_equal(&c, &d));
+        let h = crate::contact::RccHistory::decode(&d.snapshot.contact[0][0].history);
+        assert_eq!((h.beta, h.ut, h.damage), (0.25, [1e-9, -2e-9, 0.0], 0.125));
     }
 
     #[test]

@@ -5,7 +5,7 @@
 //! that is wrong and what would be valid. The format is documented in `docs/scenario.md`.
 
 use crate::contact::detect::{thickness_twins, tributary_areas};
-use crate::contact::law::{Orthotropy, DEFAULT_BETA_EPS};
+use crate::contact::law::{Interface, Orthotropy, DEFAULT_BETA_EPS};
 use crate::contact::{ContactPair, InterfaceLaw, Master, RccParams, RigidMotion, RigidShape};
 use crate::material::{self, Hyperelastic};
 use crate::mesh::generate::{self, FlatSide};
@@ -776,17 +776,18 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
                         .join(", ")
                 ))
             })?;
+        let valid = crate::output::maps::map_fields(contacts[pair].law.history_fields());
         if m.fields.is_empty() {
             return Err(ctx.err(format!(
                 "`{key}.fields` is empty; valid fields are: {}",
-                crate::output::maps::MAP_FIELDS.join(", ")
+                valid.join(", ")
             )));
         }
         for f in &m.fields {
-            if !crate::output::maps::MAP_FIELDS.contains(&f.as_str()) {
+            if !valid.contains(&f.as_str()) {
                 return Err(ctx.err(format!(
                     "`{key}.fields` holds {f:?}; valid fields are: {}",
-                    crate::output::maps::MAP_FIELDS.join(", ")
+                    valid.join(", ")
                 )));
             }
         }

@@ -21,7 +21,8 @@ pub use constraints::Constraints;
 
 use crate::assembly::{BadElement, Discretisation};
 use crate::contact::detect::{align_frames, detect, ContactPoint};
-use crate::contact::law::{accumulated_damage, BondState, ContactState, PointSolution};
+use crate::contact::history::NodeHistory;
+use crate::contact::law::{BondState, ContactState, Interface, PointSolution};
 use crate::contact::mixed::MixedWorkspace;
 use crate::linalg::LinalgError;
 use crate::problem::{ContactSolver, Problem};
@@ -124,13 +125,15 @@ pub struct StepReport {
     pub timings: PhaseTimes,
 }
 
-/// The contact state of one slave node, committed at the end of every step.
+/// The contact state of one slave node, committed at the end of every step: what every
+/// interface law has (forces, gap, slip, state, frame) and the law's own history.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct NodeContact {
-    /// Intensity of adhesion β ∈ [0, 1].
-    pub beta: f64,
-    /// Bond stretch u_t in global axes [m].
-    pub ut: [f64; 3],
+    /// The interface law's history at the node, in the order of its named fields
+    /// ([`crate::contact::Interface::history_fields`]); e.g. β, u_t and D of the RCC law
+    /// ([`crate::contact::RccHistory`]). Kept when the node leaves contact, as the law says
+    /// ([`crate::contact::Interface::release`]).
+    pub history: NodeHistory,
     /// Dry force r̄ in the local frame (t₁, t₂, n) [N].
     pub r_dry: [f64; 3],
     /// Adhesive force r̃ in the local frame [N].
@@ -145,31 +148,25 @@ pub struct NodeContact {
     pub state: i32,
     /// Tangent axes T₁, T₂ of the local frame (global components).
     pub tangent_axes: [[f64; 3]; 2],
-    /// Adhesive energy dissipated at the node so far, D [J/m²]: the interface's memory of
-    /// past debonding, which the fatigue law degrades the decohesion energy with (kept when
-    /// the node leaves contact).
-    pub damage: f64,
 }
 
 impl NodeContact {
-    /// How many numbers [`NodeContact::to_values`] gives (the state code aside).
-    pub const VALUES: usize = 23;
+    /// How many numbers [`NodeContact::to_values`] gives (the state code and the law's
+    /// history aside).
+    pub const VALUES: usize = 18;
 
-    /// Every real-valued field, in a fixed order: β, u_t (3), r̄ (3), r̃ (3), force (3), gap,
-    /// slip (2), tangent axes (2 × 3), dissipated energy. With [`NodeContact::state`] this is
-    /// the whole node (the checkpoint format).
+    /// Every real-valued field but the history, in a fixed order: r̄ (3), r̃ (3), force (3),
+    /// gap, slip (2), tangent axes (2 × 3). With [`NodeContact::state`] and
+    /// [`NodeContact::history`] this is the whole node (the checkpoint format).
     pub fn to_values(&self) -> [f64; Self::VALUES] {
         let mut v = [0.0; Self::VALUES];
-        let parts: [&[f64]; 9] = [
-            &[self.beta],
-            &self.ut,
+        let parts: [&[f64]; 6] = [
             &self.r_dry,
             &self.r_adh,
             &self.force,
             &[self.gap],
             &self.slip,
             self.tangent_axes.as_flattened(),
-            &[self.damage],
         ];
         for (slot, x) in v.iter_mut().zip(parts.into_iter().flatten()) {
             *slot = *x;
@@ -177,20 +174,19 @@ impl NodeContact {
         v
     }
 
-    /// The node whose [`NodeContact::to_values`] are `v`, with state code `state`.
-    pub fn from_values(v: &[f64; Self::VALUES], state: i32) -> Self {
+    /// The node whose [`NodeContact::to_values`] are `v`, with state code `state` and
+    /// history `history`.
+    pub fn from_values(v: &[f64; Self::VALUES], state: i32, history: NodeHistory) -> Self {
         let a3 = |k: usize| [v[k], v[k + 1], v[k + 2]];
         NodeContact {
-            beta: v[0],
-            ut: a3(1),
-            r_dry: a3(4),
-            r_adh: a3(7),
-            force: a3(10),
-            gap: v[13],
-            slip: [v[14], v[15]],
+            history,
+            r_dry: a3(0),
+            r_adh: a3(3),
+            force: a3(6),
+            gap: v[9],
+            slip: [v[10], v[11]],
             state,
-            tangent_axes: [a3(16), a3(19)],
-            damage: v[22],
+            tangent_axes: [a3(12), a3(15)],
         }
     }
 }
@@ -537,17 +533,12 @@ impl Stepper {
         sols: &[PointSolution],
         bond0: &[BondState],
     ) {
-        // Nodes that are not candidates of this step lose their bond (β = 0); what they
-        // dissipated stays.
+        // Nodes that are not candidates of this step keep what their law says.
         for (nodes, pair) in self.contact.iter_mut().zip(&self.problem.contacts) {
             for n in nodes.iter_mut() {
-                let damage = match &pair.law.adhesion {
-                    Some(a) => accumulated_damage(n.damage, n.beta, 0.0, a),
-                    None => n.damage,
-                };
                 *n = NodeContact {
                     gap: f64::NAN,
-                    damage,
+                    history: pair.law.release(&n.history),
                     ..Default::default()
                 };
             }
@@ -558,16 +549,11 @@ impl Stepper {
             let global = |v: [f64; 3]| -> [f64; 3] {
                 std::array::from_fn(|k| v[0] * f[0][k] + v[1] * f[1][k] + v[2] * f[2][k])
             };
-            let damage = match &self.problem.contacts[pt.pair].law.adhesion {
-                Some(a) => accumulated_damage(b0.damage, b0.beta, sol.beta, a),
-                None => b0.damage,
-            };
             // Each slave node of the point carries its share of the forces.
             let share = pt.node_share();
             let part = |v: [f64; 3]| v.map(|c| share * c);
             let node = NodeContact {
-                beta: sol.beta,
-                ut: global([sol.ut[0], sol.ut[1], 0.0]),
+                history: self.problem.contacts[pt.pair].law.commit(b0, sol, f),
                 r_dry: part(sol.r_dry),
                 r_adh: part(sol.r_adh),
                 force: part(global(r)),
@@ -579,7 +565,6 @@ impl Stepper {
                     ContactState::Slide => 3,
                 },
                 tangent_axes: [f[0], f[1]],
-                damage,
             };
             for local in pt.locals() {
                 self.contact[pt.pair][local] = node;
@@ -587,19 +572,15 @@ impl Stepper {
         }
     }
 
-    /// Committed bond state of each contact point, in its local frame.
+    /// Committed history of each contact point, frozen for the step, in its local frame.
     fn bonds_at_start(&self, points: &[ContactPoint]) -> Vec<BondState> {
         points
             .iter()
             .map(|pt| {
                 let c = &self.contact[pt.pair][pt.local];
-                let f = &pt.frame;
-                let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-                BondState {
-                    beta: c.beta,
-                    ut: [dot(c.ut, f[0]), dot(c.ut, f[1])],
-                    damage: c.damage,
-                }
+                self.problem.contacts[pt.pair]
+                    .law
+                    .point_history(&c.history, &pt.frame)
             })
             .collect()
     }
@@ -714,8 +695,7 @@ impl Stepper {
             .iter()
             .map(|pt| {
                 let law = &self.problem.contacts[pt.pair].law;
-                law.adhesion
-                    .map_or(0.0, |a| (pt.area * a.peak_traction()).powi(2))
+                (pt.area * law.bond_traction()).powi(2)
             })
             .sum::<f64>()
             .sqrt();

@@ -2,6 +2,7 @@
 //! plane, pulled off, pressed again and pulled off again. The bond at the centre goes
 //! 0 → 1 → 0 → 1 → 0, and the second pull-off needs the same peak force as the first.
 
+use adhesim::contact::RccHistory;
 use adhesim::time::Stepper;
 use std::path::Path;
 use std::sync::Arc;
@@ -49,7 +50,11 @@ fn bond_breaks_and_reforms_with_the_same_pull_off_force() {
     while !s.finished() {
         s.step().unwrap();
         let fy: f64 = s.contact[0].iter().map(|c| c.force[1]).sum();
-        history.push((s.state.t, s.contact[0][centre].beta, fy));
+        history.push((
+            s.state.t,
+            RccHistory::from(&s.contact[0][centre].history).beta,
+            fy,
+        ));
     }
     let beta_at = |t: f64| {
         history

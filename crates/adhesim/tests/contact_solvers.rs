@@ -4,6 +4,7 @@
 //! to the tolerance; friction must dissipate; and a plane-strain slab must carry no friction
 //! out of its plane.
 
+use adhesim::contact::RccHistory;
 use adhesim::problem::Problem;
 use adhesim::scenario::{load_with, LoadOptions, Override};
 use adhesim::time::{NodeContact, Stepper};
@@ -178,9 +179,9 @@ fn compare_with_gauss_seidel_on_the_indentation_cycle(solver: &str) -> Compariso
         .iter()
         .flat_map(|(_, c)| c.iter().flatten().map(normal))
         .fold(0.0f64, |m, v| m.max(v.abs()));
-    let (d_beta, steps) = worst_difference(&other, &gs, |n| n.beta, 1.0);
+    let (d_beta, steps) = worst_difference(&other, &gs, |n| RccHistory::from(&n.history).beta, 1.0);
     let (d_rn, _) = worst_difference(&other, &gs, normal, f_max);
-    let i_beta = worst_interpolated(&other, &gs, |n| n.beta, 1.0);
+    let i_beta = worst_interpolated(&other, &gs, |n| RccHistory::from(&n.history).beta, 1.0);
     let i_rn = worst_interpolated(&other, &gs, normal, f_max);
     eprintln!(
         "{solver}: {steps} common steps: |Δβ| ≤ {d_beta:.2e}, |Δr_n| ≤ {d_rn:.2e} of {f_max:.3e} N; \
@@ -189,7 +190,11 @@ fn compare_with_gauss_seidel_on_the_indentation_cycle(solver: &str) -> Compariso
     // The cycle bonded and de-bonded: the comparison is not of zeros.
     let peak_beta = gs
         .iter()
-        .flat_map(|(_, c)| c.iter().flatten().map(|n| n.beta))
+        .flat_map(|(_, c)| {
+            c.iter()
+                .flatten()
+                .map(|n| RccHistory::from(&n.history).beta)
+        })
         .fold(0.0, f64::max);
     assert_eq!(peak_beta, 1.0);
     Comparison {

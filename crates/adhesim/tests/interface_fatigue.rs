@@ -7,6 +7,7 @@
 //! every node, and the pull-off force of cycle k + 1 is A √(C_n w/(1 + k w/D_f)). Without
 //! fatigue every cycle is the same.
 
+use adhesim::contact::RccHistory;
 use adhesim::time::Stepper;
 use std::path::Path;
 use std::sync::Arc;
@@ -49,7 +50,7 @@ fn run(fatigue: bool) -> Vec<(f64, f64, f64)> {
             cycles[k].0 = tension;
             cycles[k].2 = (c.gap - last_gap).abs();
         }
-        cycles[k].1 = c.damage;
+        cycles[k].1 = RccHistory::from(&c.history).damage;
         last_gap = c.gap;
     }
     cycles

@@ -3,6 +3,7 @@
 //! wall-clock timing columns of history.csv excepted.
 
 use adhesim::checkpoint::{Checkpoint, CheckpointError};
+use adhesim::contact::RccHistory;
 use adhesim::output::csv::read_history;
 use adhesim::problem::Problem;
 use adhesim::run::{run_with, Outcome, RunControl, RunError, Silent};
@@ -112,7 +113,9 @@ fn stopped_and_resumed_run_equals_the_uninterrupted_one() {
     let json = std::fs::read_to_string(part.join("run.json")).unwrap();
     assert!(json.contains("\"interrupted\""), "{json}");
     // The centre is already bonded: the restart carries real adhesion state.
-    assert!(c.snapshot.contact[0].iter().any(|n| n.beta == 1.0));
+    assert!(c.snapshot.contact[0]
+        .iter()
+        .any(|n| RccHistory::from(&n.history).beta == 1.0));
 
     let s = go(
         &part,

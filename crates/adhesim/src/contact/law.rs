@@ -32,6 +32,7 @@
 
 pub use super::anisotropic::Orthotropy;
 use super::anisotropic::{scale, scale_matrix, unscale, unscale_matrix};
+use super::history::{HistoryField, LawHistory, NodeHistory};
 use std::f64::consts::PI;
 
 /// Default bond cut-off ε of the RCC law: below it a bond is broken.
@@ -146,6 +147,58 @@ impl InterfaceLaw {
         }
     }
 }
+
+/// What the stepper and the contact solves need from an interface law besides its friction
+/// cone (μ, [`InterfaceLaw::tangent_scale`]): its history at a slave node ([`LawHistory`],
+/// named fields for the outputs and the checkpoints), the frozen history the point solvers
+/// take at the start of a step, the adhesive response at that history, the history to commit
+/// from a point's solution, and the force scale of its bonds.
+///
+/// The Gauss-Seidel point solver ([`solve_point`]) evaluates the RCC adhesion of the law's
+/// parameters directly (implicitly in x, with its own warm start).
+///
+/// The RCC law, with dry Coulomb friction as its case without adhesion, implements it in
+/// `rcc.rs`; a law's history is registered in [`REGISTERED_HISTORIES`].
+pub trait Interface {
+    /// The law's history at a slave node.
+    type History: LawHistory;
+
+    /// The named fields of the history.
+    fn history_fields(&self) -> &'static [HistoryField] {
+        Self::History::FIELDS
+    }
+
+    /// Largest quasi-static traction of the law's bonds [Pa] (0 without adhesion): times a
+    /// point's area, the force its bond can carry.
+    fn bond_traction(&self) -> f64;
+
+    /// The adhesive response at the local relative displacement `x` [m] of a point whose
+    /// history is frozen at `start`, over a step of `dt` [s], with tributary area `area` [m²]
+    /// (the force r̃, its secant stiffness, the incremental potential and the history it
+    /// leads to); None for a law without adhesion. The fclib Newton and the mixed solve
+    /// linearise the law with it.
+    fn adhesive_response(
+        &self,
+        start: &BondState,
+        dt: f64,
+        area: f64,
+        x: [f64; 3],
+    ) -> Option<AdhesiveResponse>;
+
+    /// The frozen history at the start of a step of a point whose node history is `node`,
+    /// in the point's local frame `frame` (rows t₁, t₂, n in global components).
+    fn point_history(&self, node: &NodeHistory, frame: &[[f64; 3]; 3]) -> BondState;
+
+    /// The node history to commit for a point that started the step with `start` and whose
+    /// solution is `sol`, in the local frame `frame`.
+    fn commit(&self, start: &BondState, sol: &PointSolution, frame: &[[f64; 3]; 3]) -> NodeHistory;
+
+    /// The history of a node that is no longer a contact candidate, from its last one.
+    fn release(&self, node: &NodeHistory) -> NodeHistory;
+}
+
+/// The history fields of every registered interface law.
+pub const REGISTERED_HISTORIES: &[&[HistoryField]] = &[super::rcc::RccHistory::FIELDS];
 
 /// The defect r̄ − P_K(r̄ − ρ x̂) [N] of the law's bi-potential condition at a dry force `r_dry`
 /// [N] and local relative displacement `x` [m], with `rho` [N/m]: zero exactly at a solution.

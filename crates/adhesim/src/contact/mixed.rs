@@ -31,8 +31,8 @@ use faer::sparse::{Pair, SymbolicSparseColMat};
 
 use super::anisotropic::{scale, unscale};
 use super::law::{
-    adhesive_response, bipotential_trial, dry_projection, modified_displacement_jacobian,
-    projection_jacobian, BondState, InterfaceLaw, PointSolution,
+    bipotential_trial, dry_projection, modified_displacement_jacobian, projection_jacobian,
+    BondState, Interface, InterfaceLaw, PointSolution,
 };
 use super::semismooth::{ARMIJO, ETA_DOWN, ETA_MAX, ETA_MIN, ETA_START, ETA_UP};
 use crate::linalg::{metis_dof_ordering, BlockPattern};
@@ -79,9 +79,8 @@ pub fn linearise_point(
     x: V3,
 ) -> PointLinearisation {
     let mu = law.mu.max(0.0);
-    let (r_adh, k_adh, beta, ut) = match &law.adhesion {
-        Some(a) => {
-            let resp = adhesive_response(a, bond0, dt, area, x);
+    let (r_adh, k_adh, beta, ut) = match law.adhesive_response(&bond0, dt, area, x) {
+        Some(resp) => {
             let k = Mat3::from_fn(|i, j| resp.secant_stiffness[i][j]);
             (resp.force, k, resp.beta, resp.ut)
         }

@@ -2,19 +2,25 @@
 //!
 //! - [`law`]: the local law at one contact point (bi-potential projection, RCC β update, the
 //!   point solver) — pure functions.
+//! - [`history`]: a law's history at a slave node, its named fields and values; [`rcc`]: the
+//!   RCC law's history and its [`law::Interface`] implementation.
 //! - [`detect`]: contact pairs, detection once per step, local frames, gaps and the operator H.
 //! - [`solve`]: the reduced contact system inside Newton (Delassus operator W = H K̄⁻¹ Hᵀ,
 //!   nonlinear Gauss-Seidel over contact points).
 
 pub mod anisotropic;
 pub mod detect;
+pub mod history;
 pub mod law;
 pub mod mixed;
 pub mod natural_map;
 pub mod newton;
+pub mod rcc;
 pub mod reduced;
 pub mod semismooth;
 pub mod solve;
 
 pub use detect::{ContactPair, Master, RigidMotion, RigidShape};
-pub use law::{BondState, ContactState, InterfaceLaw, RccParams};
+pub use history::{HistoryField, LawHistory, NodeHistory};
+pub use law::{BondState, ContactState, Interface, InterfaceLaw, RccParams};
+pub use rcc::RccHistory;

@@ -21,7 +21,7 @@
 use super::anisotropic::{scale, scale_matrix, unscale};
 use super::detect::ContactPoint;
 use super::law::{
-    adhesive_response, bipotential_trial, dry_projection, BondState, ContactState, InterfaceLaw,
+    bipotential_trial, dry_projection, BondState, ContactState, Interface, InterfaceLaw,
     PointSolution,
 };
 use crate::system::SystemMatrix;
@@ -152,9 +152,8 @@ pub fn augmented_point(
         }
     };
     let (r_dry, state, mut stiffness) = (dry.force, dry.state, dry.stiffness);
-    let (beta, ut, r_adh, adhesive_energy) = match &law.adhesion {
-        Some(a) => {
-            let resp = adhesive_response(a, bond0, dt, area, x);
+    let (beta, ut, r_adh, adhesive_energy) = match law.adhesive_response(&bond0, dt, area, x) {
+        Some(resp) => {
             for (srow, arow) in stiffness.iter_mut().zip(resp.secant_stiffness) {
                 for (s, a) in srow.iter_mut().zip(arow) {
                     *s += a;
@@ -273,7 +272,7 @@ pub fn defect_norm(evals: &[AugmentedPoint]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::law::{ContactState, RccParams};
+    use crate::contact::law::{adhesive_response, ContactState, RccParams};
 
     fn dry(mu: f64) -> InterfaceLaw {
         InterfaceLaw {

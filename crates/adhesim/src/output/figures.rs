@@ -13,7 +13,6 @@ pub fn field_label(field: &str) -> Option<&'static str> {
         "ux" => "displacement u_x [m]",
         "uy" => "displacement u_y [m]",
         "uz" => "displacement u_z [m]",
-        "beta" => "intensity of adhesion β [-]",
         "rn" => "normal contact force r_n [N] (> 0 compression)",
         "rn_adh" => "normal adhesive force r̃_n [N] (< 0 tension)",
         "rt" => "tangential contact force ‖r_t‖ [N]",
@@ -23,7 +22,6 @@ pub fn field_label(field: &str) -> Option<&'static str> {
         "pn_adh" => "adhesive normal traction [Pa] (< 0 tension)",
         "tt" => "tangential traction ‖t_t‖ [Pa]",
         "tt_adh" => "adhesive tangential traction [Pa]",
-        "damage" => "dissipated adhesive energy D [J/m²]",
         "fx" => "total contact force F_x [N]",
         "fy" => "total contact force F_y [N]",
         "fz" => "total contact force F_z [N]",
@@ -32,7 +30,7 @@ pub fn field_label(field: &str) -> Option<&'static str> {
         "ft_norm_sum" => "sum of the nodal tangential force norms Σ‖r_t‖ [N]",
         "ft_adh_norm_sum" => "sum of the nodal adhesive tangential force norms Σ‖r̃_t‖ [N]",
         "bonded" => "bonded contact nodes [-]",
-        _ => return None,
+        _ => return crate::contact::history::field_label(field),
     })
 }
 

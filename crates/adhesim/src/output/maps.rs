@@ -10,19 +10,29 @@
 
 use super::csv::read_history;
 use super::plot::{draw_scalar_map_with, ColorMap, PlotError, ScalarMap, ScalarValues};
-use super::{contact_node_values, Observer, StepView};
+use super::{contact_node_fields, contact_node_values, Observer, StepView, CONTACT_NODE_FIELDS};
+use crate::contact::history::{self, FieldKind, HistoryField};
+use crate::contact::Interface;
 use crate::problem::MapRequest;
 use std::collections::BTreeMap;
 use std::io;
 use std::path::{Path, PathBuf};
 
-/// Contact fields that can be mapped, in the order of the map CSV columns.
-pub use super::CONTACT_NODE_FIELDS as MAP_FIELDS;
+/// The contact fields of a pair whose law has the history fields `fields` that can be
+/// mapped, in the order of the map CSV columns.
+pub fn map_fields(fields: &[HistoryField]) -> Vec<&'static str> {
+    contact_node_fields(fields)
+}
+
+/// Whether a map CSV column is a contact field of some law.
+fn is_map_field(name: &str) -> bool {
+    CONTACT_NODE_FIELDS.contains(&name)
+        || history::registered_fields().any(|f| f.kind == FieldKind::Scalar && f.name == name)
+}
 
 /// Colour-bar label (quantity and units) of a map field.
 fn map_label(field: &str) -> &'static str {
     match field {
-        "beta" => "intensity of adhesion β [-]",
         "rn" => "normal contact force r_n [N]",
         "rn_dry" => "dry normal force r̄_n [N]",
         "rn_adh" => "normal adhesive force r̃_n [N]",
@@ -35,8 +45,7 @@ fn map_label(field: &str) -> &'static str {
         "pn_adh" => "adhesive normal traction [Pa]",
         "tt" => "tangential traction ‖t_t‖ [Pa]",
         "tt_adh" => "adhesive tangential traction [Pa]",
-        "damage" => "dissipated adhesive energy D [J/m²]",
-        _ => "",
+        _ => history::field_label(field).unwrap_or(""),
     }
 }
 
@@ -110,15 +119,17 @@ impl Observer for MapObserver {
                 if t < wanted - 1e-9 * wanted.abs().max(view.report.dt) {
                     break;
                 }
+                let fields = pair.law.history_fields();
+                let names = map_fields(fields);
                 let cols: Vec<usize> = req
                     .fields
                     .iter()
-                    .filter_map(|f| MAP_FIELDS.iter().position(|m| m == f))
+                    .filter_map(|f| names.iter().position(|m| m == f))
                     .collect();
                 let mut text = String::from("node,x,y,z,t");
                 for &k in &cols {
                     text.push(',');
-                    text.push_str(MAP_FIELDS[k]);
+                    text.push_str(names[k]);
                 }
                 text.push('\n');
                 for (i, (&n, c)) in pair
@@ -129,9 +140,9 @@ impl Observer for MapObserver {
                 {
                     let x = view.disc.reference[n];
                     text.push_str(&format!("{i},{:e},{:e},{:e},{:e}", x[0], x[1], x[2], t));
-                    let values = contact_node_values(c, pair.slave_area[i]);
+                    let values = contact_node_values(c, fields, pair.slave_area[i]);
                     for &k in &cols {
-                        text.push_str(&format!(",{:e}", values[k]));
+                        text.push_str(&format!(",{:e}", values[k].1));
                     }
                     text.push('\n');
                 }
@@ -210,7 +221,7 @@ pub fn draw_map_figures(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
     let mut ranges: BTreeMap<(String, String), (f64, f64)> = BTreeMap::new();
     for m in &maps {
         for (c, name) in m.columns.iter().enumerate() {
-            if !MAP_FIELDS.contains(&name.as_str()) {
+            if !is_map_field(name) {
                 continue;
             }
             let e = ranges
@@ -260,13 +271,13 @@ pub fn draw_map_figures(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
             .filter(|q| q.iter().all(|&i| i < n))
             .collect();
         for (c, name) in m.columns.iter().enumerate() {
-            if !MAP_FIELDS.contains(&name.as_str()) {
+            if !is_map_field(name) {
                 continue;
             }
             let values: Vec<f64> = m.rows.iter().map(|r| r[c]).collect();
             let range = match name.as_str() {
-                "beta" => Some((0.0, 1.0)),
                 "state" => Some((0.0, 3.0)),
+                _ if history::field_range(name).is_some() => history::field_range(name),
                 _ => ranges
                     .get(&(m.pair.clone(), name.clone()))
                     .copied()

@@ -9,7 +9,8 @@ pub mod plot;
 pub mod vtk;
 
 use crate::assembly::Discretisation;
-use crate::contact::{Master, RigidShape};
+use crate::contact::history::{FieldKind, HistoryField, Slot};
+use crate::contact::{Interface, Master, RigidShape};
 use crate::element::{element_cauchy_stress, von_mises};
 use crate::problem::{Dirichlet, Problem};
 use crate::time::{NodeContact, State, StepReport};
@@ -251,6 +252,7 @@ impl Observer for FrameWriter {
         let mut contacts = Vec::new();
         for (j, (pair, nodes)) in view.problem.contacts.iter().zip(view.contact).enumerate() {
             let c = contact_frame(j, pair, nodes, view);
+            let history = history_columns_of(pair.law.history_fields(), nodes);
             let mut p = vtk::Piece::new(&c.points);
             if !c.quads.is_empty() {
                 p = p.with_cells(vtk::CellKind::Quad4, &c.quads);
@@ -263,8 +265,8 @@ impl Observer for FrameWriter {
             }
             let p = p
                 .with_point_data("node_id", vtk::FieldData::Int(&c.node_id))
-                .with_point_data("area", vtk::FieldData::Scalar(&pair.slave_area))
-                .with_point_data("beta", vtk::FieldData::Scalar(&c.beta))
+                .with_point_data("area", vtk::FieldData::Scalar(&pair.slave_area));
+            let p = with_history(p, &history, Slot::First)
                 .with_point_data("rn", vtk::FieldData::Scalar(&c.rn))
                 .with_point_data("rn_dry", vtk::FieldData::Scalar(&c.rn_dry))
                 .with_point_data("rn_adh", vtk::FieldData::Scalar(&c.rn_adh))
@@ -277,10 +279,10 @@ impl Observer for FrameWriter {
                 .with_point_data("tt_adh", vtk::FieldData::Vector(&c.tt_adh))
                 .with_point_data("traction", vtk::FieldData::Vector(&c.traction))
                 .with_point_data("gap", vtk::FieldData::Scalar(&c.gap))
-                .with_point_data("slip", vtk::FieldData::Scalar(&c.slip))
-                .with_point_data("ut", vtk::FieldData::Vector(&c.ut))
-                .with_point_data("state", vtk::FieldData::Int(&c.state))
-                .with_point_data("damage", vtk::FieldData::Scalar(&c.damage))
+                .with_point_data("slip", vtk::FieldData::Scalar(&c.slip));
+            let p = with_history(p, &history, Slot::Motion)
+                .with_point_data("state", vtk::FieldData::Int(&c.state));
+            let p = with_history(p, &history, Slot::Last)
                 .with_cell_data("pair_id", vtk::FieldData::Int(&c.pair_id))
                 .with_cell_data("body_id", vtk::FieldData::Int(&c.body_id));
             let file = format!("{stem}_contact{j}.vtu");
@@ -328,7 +330,6 @@ struct ContactFrame {
     triangles: Vec<usize>,
     vertices: Vec<usize>,
     node_id: Vec<i32>,
-    beta: Vec<f64>,
     rn: Vec<f64>,
     rn_dry: Vec<f64>,
     rn_adh: Vec<f64>,
@@ -342,9 +343,7 @@ struct ContactFrame {
     traction: Vec<[f64; 3]>,
     gap: Vec<f64>,
     slip: Vec<f64>,
-    ut: Vec<[f64; 3]>,
     state: Vec<i32>,
-    damage: Vec<f64>,
     pair_id: Vec<i32>,
     body_id: Vec<i32>,
 }
@@ -390,7 +389,6 @@ fn contact_frame(
         triangles,
         vertices,
         node_id: pair.slave_nodes.iter().map(|&n| id_i32(n)).collect(),
-        beta: nodes.iter().map(|c| c.beta).collect(),
         rn: nodes.iter().map(|c| c.r_dry[2] + c.r_adh[2]).collect(),
         rn_dry: nodes.iter().map(|c| c.r_dry[2]).collect(),
         rn_adh: nodes.iter().map(|c| c.r_adh[2]).collect(),
@@ -407,9 +405,7 @@ fn contact_frame(
             .iter()
             .map(|c| (c.slip[0].powi(2) + c.slip[1].powi(2)).sqrt())
             .collect(),
-        ut: nodes.iter().map(|c| c.ut).collect(),
         state: nodes.iter().map(|c| c.state).collect(),
-        damage: nodes.iter().map(|c| c.damage).collect(),
         pair_id: vec![id_i32(index); n_cells],
         body_id: vec![id_i32(slave_body); n_cells],
     };
@@ -428,6 +424,60 @@ fn contact_frame(
         f.rt_adh.push(rt_adh);
     }
     f
+}
+
+/// The values of one history field over a pair's slave nodes.
+enum HistoryColumn {
+    Scalar(Vec<f64>),
+    Vector(Vec<[f64; 3]>),
+}
+
+impl HistoryColumn {
+    fn data(&self) -> vtk::FieldData<'_> {
+        match self {
+            HistoryColumn::Scalar(v) => vtk::FieldData::Scalar(v),
+            HistoryColumn::Vector(v) => vtk::FieldData::Vector(v),
+        }
+    }
+}
+
+/// `p` with the history fields of `history` that go to `slot`, in order.
+fn with_history<'a>(
+    p: vtk::Piece<'a>,
+    history: &'a [(&'static HistoryField, HistoryColumn)],
+    slot: Slot,
+) -> vtk::Piece<'a> {
+    history
+        .iter()
+        .filter(|(f, _)| f.slot == slot)
+        .fold(p, |p, (f, col)| p.with_point_data(f.name, col.data()))
+}
+
+/// Each of the law's history fields `fields` with its values over `nodes`.
+fn history_columns_of(
+    fields: &'static [HistoryField],
+    nodes: &[NodeContact],
+) -> Vec<(&'static HistoryField, HistoryColumn)> {
+    let mut at = 0;
+    fields
+        .iter()
+        .map(|f| {
+            let k = at;
+            at += f.len();
+            let col = match f.kind {
+                FieldKind::Scalar => {
+                    HistoryColumn::Scalar(nodes.iter().map(|c| c.history.0[k]).collect())
+                }
+                FieldKind::Vector => HistoryColumn::Vector(
+                    nodes
+                        .iter()
+                        .map(|c| [c.history.0[k], c.history.0[k + 1], c.history.0[k + 2]])
+                        .collect(),
+                ),
+            };
+            (f, col)
+        })
+        .collect()
 }
 
 /// Writes `history.csv`: one row per committed step.
@@ -494,7 +544,7 @@ pub fn history_columns(problem: &Problem) -> Vec<String> {
         }
         let pairs = track_contacts(problem, tr.node);
         for &(p, _) in &pairs {
-            for f in CONTACT_NODE_FIELDS {
+            for f in contact_node_fields(problem.contacts[p].law.history_fields()) {
                 if pairs.len() == 1 {
                     c.push(format!("{}.{f}", tr.name));
                 } else {
@@ -531,7 +581,7 @@ pub const PAIR_TOTAL_FIELDS: [&str; 14] = [
 /// components) [N]; the sums of the norms of the nodal tangential forces and of their
 /// adhesive parts [N] (a measure of how much tangential force the interface carries, not a
 /// force: opposite nodal forces add up here and cancel in the resultant); the number of
-/// nodes with β > 0.
+/// bonded nodes (whose law's bond intensity, the first history value, is positive).
 pub fn pair_totals(nodes: &[NodeContact]) -> [f64; 14] {
     let mut out = [0.0; 14];
     for c in nodes {
@@ -549,7 +599,7 @@ pub fn pair_totals(nodes: &[NodeContact]) -> [f64; 14] {
         out[4] += c.r_adh[2];
         out[11] += (c.r_dry[0] + c.r_adh[0]).hypot(c.r_dry[1] + c.r_adh[1]);
         out[12] += c.r_adh[0].hypot(c.r_adh[1]);
-        if c.beta > 0.0 {
+        if c.history.bonded() {
             out[13] += 1.0;
         }
     }
@@ -643,38 +693,65 @@ fn unit(a: [f64; 3]) -> [f64; 3] {
     }
 }
 
-/// Contact fields of one slave node, as written for tracked nodes in the history and in the
-/// contact maps; [`contact_node_values`] gives them in this order.
-pub const CONTACT_NODE_FIELDS: [&str; 14] = [
-    "beta", "rn", "rn_dry", "rn_adh", "rt", "rt_adh", "gap", "slip", "state", "pn", "pn_adh", "tt",
-    "tt_adh", "damage",
+/// Contact fields that every interface law has, as written for tracked nodes in the history
+/// and in the contact maps, in order: total, dry and adhesive normal force [N], norms of the
+/// total and adhesive tangential force [N], gap [m], slip of the step [m], state code, then
+/// the same forces as tractions [Pa]: contact pressure, adhesive normal traction, norms of
+/// the total and adhesive tangential tractions. The law's scalar history fields go around
+/// them by their [`Slot`]: `First` before, `Motion` after `slip`, `Last` after all
+/// ([`contact_node_values`]).
+pub const CONTACT_NODE_FIELDS: [&str; 12] = [
+    "rn", "rn_dry", "rn_adh", "rt", "rt_adh", "gap", "slip", "state", "pn", "pn_adh", "tt",
+    "tt_adh",
 ];
 
-/// The [`CONTACT_NODE_FIELDS`] of one slave node of tributary area `area` [m²]: β, total,
-/// dry and adhesive normal force [N], norms of the total and adhesive tangential force [N],
-/// gap [m], slip of the step [m], state code, then the same forces as tractions [Pa]:
-/// contact pressure, adhesive normal traction, norms of the total and adhesive tangential
-/// tractions; last the adhesive energy dissipated so far [J/m²].
-pub fn contact_node_values(c: &NodeContact, area: f64) -> [f64; 14] {
+/// Names of the contact fields of a slave node whose law has the history fields `fields`,
+/// in the order of [`contact_node_values`].
+pub fn contact_node_fields(fields: &[HistoryField]) -> Vec<&'static str> {
+    contact_node_values(&NodeContact::default(), fields, 0.0)
+        .into_iter()
+        .map(|(name, _)| name)
+        .collect()
+}
+
+/// The contact fields of one slave node of tributary area `area` [m²] whose law has the
+/// history fields `fields`, named: the [`CONTACT_NODE_FIELDS`] with the law's scalar history
+/// fields placed by their [`Slot`].
+pub fn contact_node_values(
+    c: &NodeContact,
+    fields: &[HistoryField],
+    area: f64,
+) -> Vec<(&'static str, f64)> {
     let rn = c.r_dry[2] + c.r_adh[2];
     let rt = (c.r_dry[0] + c.r_adh[0]).hypot(c.r_dry[1] + c.r_adh[1]);
     let rt_adh = c.r_adh[0].hypot(c.r_adh[1]);
-    [
-        c.beta,
-        rn,
-        c.r_dry[2],
-        c.r_adh[2],
-        rt,
-        rt_adh,
-        c.gap,
-        c.slip[0].hypot(c.slip[1]),
-        c.state as f64,
-        traction(rn, area),
-        traction(c.r_adh[2], area),
-        traction(rt, area),
-        traction(rt_adh, area),
-        c.damage,
-    ]
+    let history = |slot: Slot| {
+        c.history
+            .fields(fields)
+            .filter(move |(f, _)| f.kind == FieldKind::Scalar && f.slot == slot)
+            .map(|(f, v)| (f.name, v[0]))
+    };
+    let mut out = Vec::with_capacity(CONTACT_NODE_FIELDS.len() + fields.len());
+    out.extend(history(Slot::First));
+    out.extend([
+        ("rn", rn),
+        ("rn_dry", c.r_dry[2]),
+        ("rn_adh", c.r_adh[2]),
+        ("rt", rt),
+        ("rt_adh", rt_adh),
+        ("gap", c.gap),
+        ("slip", c.slip[0].hypot(c.slip[1])),
+    ]);
+    out.extend(history(Slot::Motion));
+    out.extend([
+        ("state", c.state as f64),
+        ("pn", traction(rn, area)),
+        ("pn_adh", traction(c.r_adh[2], area)),
+        ("tt", traction(rt, area)),
+        ("tt_adh", traction(rt_adh, area)),
+    ]);
+    out.extend(history(Slot::Last));
+    out
 }
 
 /// (pair, index within the pair) for every pair of which a tracked node is a slave node.
@@ -792,8 +869,10 @@ impl Observer for HistoryObserver {
             row.extend_from_slice(&view.state.u[3 * n..3 * n + 3]);
             row.extend_from_slice(&view.state.v[3 * n..3 * n + 3]);
             for (p, i) in track_contacts(view.problem, n) {
-                let area = view.problem.contacts[p].slave_area[i];
-                row.extend_from_slice(&contact_node_values(&view.contact[p][i], area));
+                let pair = &view.problem.contacts[p];
+                let fields = pair.law.history_fields();
+                let values = contact_node_values(&view.contact[p][i], fields, pair.slave_area[i]);
+                row.extend(values.into_iter().map(|(_, v)| v));
             }
         }
         self.writer.append(&row)
@@ -803,6 +882,7 @@ impl Observer for HistoryObserver {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::contact::LawHistory;
 
     #[test]
     fn frame_files_are_recognised_by_their_number() {
@@ -853,7 +933,11 @@ mod tests {
             r_dry: [3.0, 0.0, 2.0],
             force: [0.0, 2.0, 3.0],
             tangent_axes: axes,
-            beta: 0.5,
+            history: crate::contact::RccHistory {
+                beta: 0.5,
+                ..Default::default()
+            }
+            .encode(),
             ..Default::default()
         };
         let b = NodeContact {
@@ -873,6 +957,36 @@ mod tests {
         assert_eq!(get("ft_norm_sum"), 6.0);
         assert_eq!(get("ft_adh_norm_sum"), 3.0);
         assert_eq!((get("fn"), get("fn_adh"), get("bonded")), (7.0, 5.0, 1.0));
+    }
+
+    /// The RCC law's contact fields, in the order the history and the maps have always had
+    /// them: β first, D last.
+    #[test]
+    fn rcc_contact_node_fields_keep_their_order() {
+        use crate::contact::{InterfaceLaw, RccHistory};
+        let fields = InterfaceLaw::coulomb(0.3).history_fields();
+        assert_eq!(
+            contact_node_fields(fields),
+            [
+                "beta", "rn", "rn_dry", "rn_adh", "rt", "rt_adh", "gap", "slip", "state", "pn",
+                "pn_adh", "tt", "tt_adh", "damage"
+            ]
+        );
+        let c = NodeContact {
+            history: RccHistory {
+                beta: 0.25,
+                ut: [1.0, 2.0, 3.0],
+                damage: 0.5,
+            }
+            .encode(),
+            r_adh: [0.0, 0.0, -2.0],
+            ..Default::default()
+        };
+        let v = contact_node_values(&c, fields, 4.0);
+        assert_eq!(v[0], ("beta", 0.25));
+        assert_eq!(v[3], ("rn_adh", -2.0));
+        assert_eq!(v[10], ("pn_adh", -0.5));
+        assert_eq!(v[13], ("damage", 0.5));
     }
 
     #[test]

@@ -1,0 +1,142 @@
+//! The history an interface law keeps at each slave node between steps, and what the rest of
+//! the program knows about it: named fields (name, quantity and unit, kind, where they go in
+//! the outputs) and their values. Outputs (history columns, VTK contact fields, maps,
+//! figures) and checkpoints iterate over these fields; none of them names a law's field.
+//!
+//! A law's history is a typed value (e.g. [`super::rcc::RccHistory`]) that implements
+//! [`LawHistory`]: it lists its [`HistoryField`]s once and encodes itself, in global axes, to
+//! a law-agnostic [`NodeHistory`] (a short array of numbers in the order of its fields). The
+//! stepper stores a [`NodeHistory`] per slave node; the law turns it back into its typed
+//! history at the start of a step and writes the committed one at its end
+//! ([`super::law::Interface`]).
+
+/// Largest number of values a node's history holds ([`NodeHistory`]): a scalar field takes
+/// one, a vector field three.
+pub const MAX_HISTORY_VALUES: usize = 8;
+
+/// What a history field holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FieldKind {
+    /// One number.
+    Scalar,
+    /// A vector in global axes (three numbers), e.g. a tangential stretch. Vector fields go to
+    /// the VTK outputs only; the history and the maps carry scalars.
+    Vector,
+}
+
+/// Where a history field goes among the contact fields that every law has (forces, gap,
+/// slip, state, tractions), in the history columns, the maps and the VTK contact fields.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Slot {
+    /// Before the forces: the first contact fields of a node.
+    First,
+    /// After the gap and slip, before the contact state: with the kinematics.
+    Motion,
+    /// After all the others.
+    Last,
+}
+
+/// One named field of a law's history.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HistoryField {
+    /// Name of the field in the outputs (history column suffix, map field, VTK array).
+    pub name: &'static str,
+    /// Quantity and unit, the axis or colour-bar label of its figures.
+    pub label: &'static str,
+    /// Scalar or vector.
+    pub kind: FieldKind,
+    /// Where it goes among the contact fields.
+    pub slot: Slot,
+    /// Fixed colour range of its maps, or None for the range of the values.
+    pub range: Option<(f64, f64)>,
+}
+
+impl HistoryField {
+    /// How many values the field takes in a [`NodeHistory`].
+    pub const fn len(&self) -> usize {
+        match self.kind {
+            FieldKind::Scalar => 1,
+            FieldKind::Vector => 3,
+        }
+    }
+
+    /// Always false: a field has at least one value.
+    pub const fn is_empty(&self) -> bool {
+        false
+    }
+}
+
+/// How many values the fields `fields` take in a [`NodeHistory`].
+pub fn values_of(fields: &[HistoryField]) -> usize {
+    fields.iter().map(HistoryField::len).sum()
+}
+
+/// The history of one slave node as plain numbers, in the order of its law's
+/// [`HistoryField`]s (global axes for vectors), zero-padded to [`MAX_HISTORY_VALUES`].
+///
+/// By convention the first value is the law's bond intensity: a node counts as bonded (the
+/// `bonded` column of a pair) when it is positive. A law without bonds keeps it 0.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NodeHistory(pub [f64; MAX_HISTORY_VALUES]);
+
+impl NodeHistory {
+    /// Whether the node is bonded (its first value is positive).
+    pub fn bonded(&self) -> bool {
+        self.0[0] > 0.0
+    }
+
+    /// Each field of `fields` with its values (one, or three for a vector).
+    pub fn fields<'a>(
+        &'a self,
+        fields: &'a [HistoryField],
+    ) -> impl Iterator<Item = (&'a HistoryField, &'a [f64])> + 'a {
+        let mut at = 0;
+        fields.iter().map(move |f| {
+            let v = &self.0[at..at + f.len()];
+            at += f.len();
+            (f, v)
+        })
+    }
+
+    /// The value of the scalar field `name` of `fields`, or None if there is none.
+    pub fn scalar(&self, fields: &[HistoryField], name: &str) -> Option<f64> {
+        self.fields(fields)
+            .find(|(f, _)| f.name == name && f.kind == FieldKind::Scalar)
+            .map(|(_, v)| v[0])
+    }
+}
+
+/// A law's typed history at a slave node.
+pub trait LawHistory: Copy + Default + PartialEq + std::fmt::Debug {
+    /// Its fields, in the order of [`LawHistory::encode`]; together they take at most
+    /// [`MAX_HISTORY_VALUES`] values.
+    const FIELDS: &'static [HistoryField];
+
+    /// The values of its fields, in order.
+    fn encode(&self) -> NodeHistory;
+
+    /// The history whose [`LawHistory::encode`] is `h`.
+    fn decode(h: &NodeHistory) -> Self;
+}
+
+/// The history fields of every registered law (one list per law), for the labels of
+/// figures drawn from a history file alone.
+pub fn registered_fields() -> impl Iterator<Item = &'static HistoryField> {
+    super::law::REGISTERED_HISTORIES
+        .iter()
+        .flat_map(|f| f.iter())
+}
+
+/// Quantity and unit of the history field `name` of any registered law.
+pub fn field_label(name: &str) -> Option<&'static str> {
+    registered_fields()
+        .find(|f| f.name == name)
+        .map(|f| f.label)
+}
+
+/// Fixed colour range of the maps of the history field `name` of any registered law.
+pub fn field_range(name: &str) -> Option<(f64, f64)> {
+    registered_fields()
+        .find(|f| f.name == name)
+        .and_then(|f| f.range)
+}
