@@ -113,10 +113,12 @@ pub enum ContactSolver {
     Auto,
 }
 
-/// Contact candidates from which [`ContactSolver::Auto`] solves a step without W: below it
-/// Gauss-Seidel with a reused W is as fast or faster (about equal at 100 points, 3 times
-/// slower at 1,024, docs/contact-solver.md) and W is at most 18 MB.
-pub const AUTO_SEMISMOOTH_FROM: usize = 500;
+/// Contact candidates from which [`ContactSolver::Auto`] solves a step without W. Measured
+/// (docs/contact-solver.md): Gauss-Seidel with a reused W is about 10 % faster on the
+/// README example (at most 94 candidates, with adhesion), the semismooth solve about 30 %
+/// faster on the pad at 100 contact nodes, 17 % on the 4.4 twist (441) and 3 times at 1,024.
+/// The switch sits above the first, where W is 3 MB.
+pub const AUTO_SEMISMOOTH_FROM: usize = 200;
 
 impl ContactSolver {
     /// The solver used for a step with `candidates` contact candidates.
