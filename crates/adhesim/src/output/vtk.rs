@@ -51,12 +51,15 @@ pub enum CellKind {
     Tri3,
     /// Single point (`VTK_VERTEX`, 1).
     Vertex,
+    /// A volume element type of the element-type table, with its VTK type and node count.
+    Element(&'static crate::element::ElementType),
 }
 
 impl CellKind {
     /// The VTK cell type number.
     pub const fn vtk_type(self) -> u8 {
         match self {
+            CellKind::Element(e) => e.vtk_type,
             CellKind::Hex8 => 12,
             CellKind::Tet4 => 10,
             CellKind::Quad4 => 9,
@@ -68,6 +71,7 @@ impl CellKind {
     /// Number of nodes of one cell of this kind.
     pub const fn num_nodes(self) -> usize {
         match self {
+            CellKind::Element(e) => e.nodes,
             CellKind::Hex8 => 8,
             CellKind::Tet4 | CellKind::Quad4 => 4,
             CellKind::Tri3 => 3,

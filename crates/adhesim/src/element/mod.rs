@@ -1,61 +1,165 @@
-//! Total-Lagrangian solid elements: trilinear hex8 (2×2×2 Gauss) and linear tet4 (1 point).
+//! Total-Lagrangian solid elements behind one interface.
+//!
+//! Every element type has two faces:
+//! - a row of the type table [`ELEMENT_TYPES`] ([`ElementType`]): its name, node count,
+//!   number of Gauss points, faces, VTK cell type and Gmsh element type, and a constructor of
+//!   its assembly block. Meshes, the Gmsh reader, VTK output and the discretisation only go
+//!   through this table;
+//! - an implementation of the [`Element`] trait (shape functions, Gauss rule, mass), with the
+//!   node count `N` and Gauss-point count `G` as const parameters, so that the kernels below
+//!   and the assembly loops are compiled for each type (no dynamic dispatch per element or
+//!   Gauss point).
+//!
+//! The types are trilinear hex8 (2×2×2 Gauss, [`hex8`]) and linear tet4 (1 point, [`tet4`]).
 //! Reference-configuration data (shape-function gradients, weights) are computed once; the
 //! kernels turn nodal displacements into internal force, consistent tangent (material +
 //! geometric) and strain energy.
+
+pub mod hex8;
+pub mod tet4;
+
+pub use hex8::{
+    hex8_centre, hex8_gauss_points, hex8_geometry, hex8_shape, Hex8, HEX8, HEX_NODE_XI,
+};
+pub use tet4::{tet4_geometry, tet4_shape, Tet4, TET4};
 
 use crate::material::Hyperelastic;
 use crate::{Mat3, Vec3};
 use nalgebra::SMatrix;
 
-/// Natural coordinates of the hex8 nodes (VTK order).
-pub const HEX_NODE_XI: [[f64; 3]; 8] = [
-    [-1.0, -1.0, -1.0],
-    [1.0, -1.0, -1.0],
-    [1.0, 1.0, -1.0],
-    [-1.0, 1.0, -1.0],
-    [-1.0, -1.0, 1.0],
-    [1.0, -1.0, 1.0],
-    [1.0, 1.0, 1.0],
-    [-1.0, 1.0, 1.0],
-];
+/// The element types adhesim knows, in the order cell blocks are kept in meshes, element
+/// blocks in the discretisation and cells in the output. A new element type is one file in
+/// this module (its [`Element`] implementation and its [`ElementType`] row) and one entry
+/// here.
+pub static ELEMENT_TYPES: &[&ElementType] = &[&HEX8, &TET4];
 
-/// Hex8 shape functions and their natural derivatives at ξ.
-pub fn hex8_shape(xi: [f64; 3]) -> ([f64; 8], [[f64; 3]; 8]) {
-    let mut n = [0.0; 8];
-    let mut dn = [[0.0; 3]; 8];
-    for a in 0..8 {
-        let [xa, ya, za] = HEX_NODE_XI[a];
-        let (fx, fy, fz) = (1.0 + xi[0] * xa, 1.0 + xi[1] * ya, 1.0 + xi[2] * za);
-        n[a] = 0.125 * fx * fy * fz;
-        dn[a] = [
-            0.125 * xa * fy * fz,
-            0.125 * fx * ya * fz,
-            0.125 * fx * fy * za,
-        ];
-    }
-    (n, dn)
+/// One row of the element-type table.
+#[derive(Debug)]
+pub struct ElementType {
+    /// Name (as in messages and Gmsh's element list), e.g. `"hex8"`.
+    pub name: &'static str,
+    /// Number of nodes of one cell.
+    pub nodes: usize,
+    /// Number of Gauss points of the element's rule.
+    pub gauss_points: usize,
+    /// Local node indices of each face (a quadrilateral or a triangle), counter-clockwise
+    /// seen from outside the cell: boundary extraction and face sets use them.
+    pub faces: &'static [&'static [usize]],
+    /// Corners for the scaled-Jacobian quality measure ([`crate::mesh::quality`]): each the
+    /// corner node and its three neighbours along the natural axes, ordered so that the edge
+    /// vectors form a right-handed frame in a valid cell.
+    pub corner_frames: &'static [[usize; 4]],
+    /// True when a cell with node coordinates `x` [m] is inverted somewhere the corner frames
+    /// do not see (for the hex8: a Jacobian determinant ≤ 0 at a Gauss point).
+    pub inverted_inside: fn(x: &[[f64; 3]]) -> bool,
+    /// VTK cell type number.
+    pub vtk_type: u8,
+    /// Gmsh element type number (MSH 4.1).
+    pub gmsh_type: i32,
+    /// An empty assembly block of this type, with the kernels compiled for it.
+    pub new_block: fn() -> Box<dyn crate::assembly::Block>,
 }
 
-/// Tet4 shape functions and natural derivatives (ξ = barycentric coordinates 1..3).
-pub fn tet4_shape(xi: [f64; 3]) -> ([f64; 4], [[f64; 3]; 4]) {
-    let n = [1.0 - xi[0] - xi[1] - xi[2], xi[0], xi[1], xi[2]];
-    let dn = [
-        [-1.0, -1.0, -1.0],
-        [1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, 0.0, 1.0],
-    ];
-    (n, dn)
+impl PartialEq for ElementType {
+    fn eq(&self, other: &Self) -> bool {
+        self.name == other.name
+    }
 }
 
-/// 2×2×2 Gauss points of the hex8 (unit weights).
-pub fn hex8_gauss_points() -> [[f64; 3]; 8] {
-    let g = 1.0 / 3f64.sqrt();
-    let mut pts = [[0.0; 3]; 8];
-    for (p, xi) in pts.iter_mut().zip(HEX_NODE_XI.iter()) {
-        *p = [g * xi[0], g * xi[1], g * xi[2]];
+impl Eq for ElementType {}
+
+impl std::hash::Hash for ElementType {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        self.name.hash(state);
     }
-    pts
+}
+
+impl ElementType {
+    /// Position of this type in [`ELEMENT_TYPES`].
+    pub fn index(&self) -> usize {
+        ELEMENT_TYPES
+            .iter()
+            .position(|t| *t == self)
+            .expect("every element type is in the table")
+    }
+
+    /// The type of Gmsh element type number `gmsh_type`, if adhesim has it.
+    pub fn from_gmsh(gmsh_type: i32) -> Option<&'static ElementType> {
+        ELEMENT_TYPES
+            .iter()
+            .copied()
+            .find(|t| t.gmsh_type == gmsh_type)
+    }
+
+    /// The type called `name`, if adhesim has it.
+    pub fn from_name(name: &str) -> Option<&'static ElementType> {
+        ELEMENT_TYPES.iter().copied().find(|t| t.name == name)
+    }
+}
+
+/// The volumetric treatment an element type offers for nearly incompressible bodies (the
+/// body's [`crate::fbar::Formulation`] switches it on).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stabilisation {
+    /// None: the element always uses the standard kinematics.
+    None,
+    /// F-bar with the element's mean dilatation ([`crate::fbar`]), for the formulations
+    /// `FBar` and `AveragedNodalPressure`.
+    FBar,
+    /// Averaged nodal pressure ([`crate::anp`], built on the tet4 block only), for the formulation
+    /// `AveragedNodalPressure` with a material that has a volumetric/isochoric split.
+    NodalPressure,
+}
+
+/// An element type at compile time: `N` nodes, `G` Gauss points. Assembly is generic over
+/// it, so each type gets its own compiled kernels.
+pub trait Element<const N: usize, const G: usize>: Send + Sync + 'static {
+    /// The type's row in [`ELEMENT_TYPES`].
+    const TYPE: &'static ElementType;
+    /// What the locking-free formulations do to this element.
+    const STABILISATION: Stabilisation;
+
+    /// Shape functions N_a and their natural derivatives ∂N_a/∂ξ at natural point ξ.
+    fn shape(xi: [f64; 3]) -> ([f64; N], [[f64; 3]; N]);
+
+    /// Gauss points (natural coordinates) and weights (natural volume).
+    fn gauss_rule() -> [([f64; 3], f64); G];
+
+    /// Gauss-point data of an element with reference coordinates `x` [m].
+    fn geometry(x: &[[f64; 3]; N]) -> Result<[GaussPoint<N>; G], DegenerateElement> {
+        let mut out = [GaussPoint {
+            shape: [0.0; N],
+            grad: [[0.0; 3]; N],
+            weight: 0.0,
+        }; G];
+        for (o, (p, w)) in out.iter_mut().zip(Self::gauss_rule()) {
+            let (n, dn) = Self::shape(p);
+            *o = gauss_point(x, n, dn, w)?;
+        }
+        Ok(out)
+    }
+
+    /// Consistent mass coefficients m_ab = ∫ ρ N_a N_b dV₀ [kg] from the Gauss data and the
+    /// density [kg/m³]; by default the element's own quadrature.
+    fn mass(gps: &[GaussPoint<N>; G], density: f64) -> [[f64; N]; N] {
+        quadrature_mass(gps, density)
+    }
+}
+
+/// m_ab = Σ_g ρ N_a N_b w_g [kg] over the Gauss points `gps`, density ρ [kg/m³].
+pub fn quadrature_mass<const N: usize, const G: usize>(
+    gps: &[GaussPoint<N>; G],
+    density: f64,
+) -> [[f64; N]; N] {
+    let mut m = [[0.0; N]; N];
+    for gp in gps {
+        for a in 0..N {
+            for b in 0..N {
+                m[a][b] += density * gp.shape[a] * gp.shape[b] * gp.weight;
+            }
+        }
+    }
+    m
 }
 
 /// Reference-configuration data at one Gauss point of an element with N nodes.
@@ -76,7 +180,7 @@ pub struct DegenerateElement {
     pub det: f64,
 }
 
-fn gauss_point<const N: usize>(
+pub(crate) fn gauss_point<const N: usize>(
     x: &[[f64; 3]; N],
     shape: [f64; N],
     dn: [[f64; 3]; N],
@@ -108,60 +212,6 @@ fn gauss_point<const N: usize>(
         grad,
         weight: w * det,
     })
-}
-
-/// Gauss-point data of a hex8 with reference coordinates `x` [m].
-pub fn hex8_geometry(x: &[[f64; 3]; 8]) -> Result<[GaussPoint<8>; 8], DegenerateElement> {
-    let pts = hex8_gauss_points();
-    let mut out = [GaussPoint {
-        shape: [0.0; 8],
-        grad: [[0.0; 3]; 8],
-        weight: 0.0,
-    }; 8];
-    for (o, p) in out.iter_mut().zip(pts) {
-        let (n, dn) = hex8_shape(p);
-        *o = gauss_point(x, n, dn, 1.0)?;
-    }
-    Ok(out)
-}
-
-/// Shape-function data at the centre (ξ = 0) of a hex8 with reference coordinates `x` [m],
-/// weight 8 (the natural volume), as the F-bar element needs.
-pub fn hex8_centre(x: &[[f64; 3]; 8]) -> Result<GaussPoint<8>, DegenerateElement> {
-    let (n, dn) = hex8_shape([0.0; 3]);
-    gauss_point(x, n, dn, 8.0)
-}
-
-/// Gauss-point data of a tet4 with reference coordinates `x` [m] (one point, weight 1/6).
-pub fn tet4_geometry(x: &[[f64; 3]; 4]) -> Result<[GaussPoint<4>; 1], DegenerateElement> {
-    let (n, dn) = tet4_shape([0.25; 3]);
-    Ok([gauss_point(x, n, dn, 1.0 / 6.0)?])
-}
-
-/// Consistent mass coefficients m_ab = ∫ ρ N_a N_b dV₀ [kg] (each multiplies the 3×3
-/// identity). For tet4 the exact closed form ρV/20 (1 + δ_ab) is used.
-pub fn consistent_mass<const N: usize, const G: usize>(
-    gps: &[GaussPoint<N>; G],
-    density: f64,
-) -> [[f64; N]; N] {
-    let mut m = [[0.0; N]; N];
-    if N == 4 && G == 1 {
-        let v = gps[0].weight;
-        for a in 0..N {
-            for b in 0..N {
-                m[a][b] = density * v / 20.0 * if a == b { 2.0 } else { 1.0 };
-            }
-        }
-        return m;
-    }
-    for gp in gps {
-        for a in 0..N {
-            for b in 0..N {
-                m[a][b] += density * gp.shape[a] * gp.shape[b] * gp.weight;
-            }
-        }
-    }
-    m
 }
 
 /// What the element kernel computes at a given displacement.
