@@ -11,7 +11,10 @@ use super::{gauss_point, DegenerateElement, Element, ElementType, GaussPoint, St
 pub static HEX8: ElementType = ElementType {
     name: "hex8",
     nodes: 8,
+    natural_nodes: &HEX_NODE_XI,
     gauss_points: 8,
+    gauss_rule: super::gauss_rule_of::<Hex8, 8, 8>,
+    shape: super::shape_of::<Hex8, 8, 8>,
     faces: &[
         &[0, 3, 2, 1], // ζ = −1
         &[4, 5, 6, 7], // ζ = +1

@@ -1,6 +1,6 @@
 //! Total-Lagrangian solid elements behind one interface.
 //!
-//! Every element type has two faces:
+//! Every element type has two sides:
 //! - a row of the type table [`ELEMENT_TYPES`] ([`ElementType`]): its name, node count,
 //!   number of Gauss points, faces, VTK cell type and Gmsh element type, and a constructor of
 //!   its assembly block. Meshes, the Gmsh reader, VTK output and the discretisation only go
@@ -40,8 +40,16 @@ pub struct ElementType {
     pub name: &'static str,
     /// Number of nodes of one cell.
     pub nodes: usize,
+    /// Natural coordinates ξ of the nodes.
+    pub natural_nodes: &'static [[f64; 3]],
     /// Number of Gauss points of the element's rule.
     pub gauss_points: usize,
+    /// The Gauss rule: natural coordinates and weight (natural volume) of each point, as
+    /// [`Element::gauss_rule`] gives them.
+    pub gauss_rule: fn() -> Vec<([f64; 3], f64)>,
+    /// Shape functions N_a and natural derivatives ∂N_a/∂ξ at ξ, as [`Element::shape`]
+    /// gives them.
+    pub shape: fn(xi: [f64; 3]) -> (Vec<f64>, Vec<[f64; 3]>),
     /// Local node indices of each face (a quadrilateral or a triangle), counter-clockwise
     /// seen from outside the cell: boundary extraction and face sets use them.
     pub faces: &'static [&'static [usize]],
@@ -144,6 +152,19 @@ pub trait Element<const N: usize, const G: usize>: Send + Sync + 'static {
     fn mass(gps: &[GaussPoint<N>; G], density: f64) -> [[f64; N]; N] {
         quadrature_mass(gps, density)
     }
+}
+
+/// [`Element::gauss_rule`] of `E` as a list, for its [`ElementType`] row.
+pub fn gauss_rule_of<E: Element<N, G>, const N: usize, const G: usize>() -> Vec<([f64; 3], f64)> {
+    E::gauss_rule().to_vec()
+}
+
+/// [`Element::shape`] of `E` at ξ as lists, for its [`ElementType`] row.
+pub fn shape_of<E: Element<N, G>, const N: usize, const G: usize>(
+    xi: [f64; 3],
+) -> (Vec<f64>, Vec<[f64; 3]>) {
+    let (n, dn) = E::shape(xi);
+    (n.to_vec(), dn.to_vec())
 }
 
 /// m_ab = Σ_g ρ N_a N_b w_g [kg] over the Gauss points `gps`, density ρ [kg/m³].
@@ -426,4 +447,111 @@ pub fn von_mises(s: &Mat3) -> f64 {
     ];
     let sh = s[(0, 1)].powi(2) + s[(1, 2)].powi(2) + s[(0, 2)].powi(2);
     (0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) + 3.0 * sh).sqrt()
+}
+
+#[cfg(test)]
+mod table_tests {
+    //! Checks every row of the element-type table against its own definition, so that a new
+    //! type is checked as soon as it is in the table.
+    use super::*;
+
+    fn sub(a: [f64; 3], b: [f64; 3]) -> Vec3 {
+        Vec3::new(a[0] - b[0], a[1] - b[1], a[2] - b[2])
+    }
+
+    /// Shape functions interpolate the nodes (N_a(ξ_b) = δ_ab) and form a partition of unity
+    /// with derivatives summing to zero at the Gauss points; the weights add up to the
+    /// natural volume (the reference cell's volume by the divergence theorem over its faces).
+    /// Exact in exact arithmetic; 1e-14 allows for round-off of sums of a few terms of order 1.
+    #[test]
+    fn shape_functions_and_gauss_rule_are_consistent() {
+        for t in ELEMENT_TYPES {
+            assert_eq!(t.natural_nodes.len(), t.nodes, "{}", t.name);
+            for (b, xb) in t.natural_nodes.iter().enumerate() {
+                let (n, dn) = (t.shape)(*xb);
+                assert_eq!((n.len(), dn.len()), (t.nodes, t.nodes), "{}", t.name);
+                for (a, na) in n.iter().enumerate() {
+                    let delta = if a == b { 1.0 } else { 0.0 };
+                    assert!(
+                        (na - delta).abs() < 1e-14,
+                        "{}: N_{a}(ξ_{b}) = {na}",
+                        t.name
+                    );
+                }
+            }
+            let rule = (t.gauss_rule)();
+            assert_eq!(rule.len(), t.gauss_points, "{}", t.name);
+            for (xi, _) in &rule {
+                let (n, dn) = (t.shape)(*xi);
+                assert!((n.iter().sum::<f64>() - 1.0).abs() < 1e-14, "{}", t.name);
+                for k in 0..3 {
+                    assert!(
+                        dn.iter().map(|d| d[k]).sum::<f64>().abs() < 1e-14,
+                        "{}",
+                        t.name
+                    );
+                }
+            }
+            // Volume of the natural cell from its faces: V = (1/3) Σ_f ∫ x·n dA, each face
+            // split into triangles fanning from its first node (planar faces).
+            let x = t.natural_nodes;
+            let mut volume = 0.0;
+            for f in t.faces {
+                for k in 1..f.len() - 1 {
+                    let (p, q, r) = (x[f[0]], x[f[k]], x[f[k + 1]]);
+                    volume += Vec3::from(p).dot(&sub(q, p).cross(&sub(r, p))) / 6.0;
+                }
+            }
+            let weights: f64 = rule.iter().map(|(_, w)| w).sum();
+            assert!(
+                (weights - volume).abs() < 1e-14,
+                "{}: Σw = {weights}, V = {volume}",
+                t.name
+            );
+        }
+    }
+
+    /// Each face is listed counter-clockwise seen from outside (its normal points away from
+    /// the natural cell's centroid), every boundary of the reference cell is covered once
+    /// (each edge of the faces is shared by exactly two faces, in opposite directions), and
+    /// the reference cell passes the quality checks.
+    #[test]
+    fn faces_are_outward_and_close_the_cell() {
+        for t in ELEMENT_TYPES {
+            let x = t.natural_nodes;
+            let c = x
+                .iter()
+                .fold([0.0; 3], |s, p| [s[0] + p[0], s[1] + p[1], s[2] + p[2]]);
+            let c = c.map(|v| v / t.nodes as f64);
+            let mut edges = std::collections::HashMap::new();
+            for f in t.faces {
+                let normal = sub(x[f[1]], x[f[0]]).cross(&sub(x[f[2]], x[f[0]]));
+                assert!(normal.dot(&sub(x[f[0]], c)) > 0.0, "{}: face {f:?}", t.name);
+                for k in 0..f.len() {
+                    *edges.entry((f[k], f[(k + 1) % f.len()])).or_insert(0) += 1;
+                }
+            }
+            for (&(a, b), &n) in &edges {
+                assert_eq!(n, 1, "{}: edge {a}-{b} twice in one direction", t.name);
+                assert_eq!(edges.get(&(b, a)), Some(&1), "{}: edge {a}-{b}", t.name);
+            }
+            assert!(!(t.inverted_inside)(x), "{}", t.name);
+            for fr in t.corner_frames {
+                let det = sub(x[fr[1]], x[fr[0]])
+                    .dot(&sub(x[fr[2]], x[fr[0]]).cross(&sub(x[fr[3]], x[fr[0]])));
+                assert!(det > 0.0, "{}: corner frame {fr:?}", t.name);
+            }
+        }
+    }
+
+    /// The table's name, node and Gmsh lookups find each row, and its block is of its type.
+    #[test]
+    fn lookups_and_blocks_match_the_rows() {
+        for (i, t) in ELEMENT_TYPES.iter().enumerate() {
+            assert_eq!(t.index(), i);
+            assert_eq!(ElementType::from_name(t.name), Some(*t));
+            assert_eq!(ElementType::from_gmsh(t.gmsh_type), Some(*t));
+            assert_eq!((t.new_block)().element_type(), *t);
+        }
+    }
 }

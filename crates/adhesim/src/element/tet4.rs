@@ -8,7 +8,15 @@ use super::{DegenerateElement, Element, ElementType, GaussPoint, Stabilisation};
 pub static TET4: ElementType = ElementType {
     name: "tet4",
     nodes: 4,
+    natural_nodes: &[
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    ],
     gauss_points: 1,
+    gauss_rule: super::gauss_rule_of::<Tet4, 4, 1>,
+    shape: super::shape_of::<Tet4, 4, 1>,
     faces: &[&[0, 2, 1], &[0, 1, 3], &[1, 2, 3], &[0, 3, 2]],
     corner_frames: &[[0, 1, 2, 3]],
     inverted_inside: |_| false,
