@@ -48,7 +48,7 @@ pub struct ElementType {
     pub gauss_rule: fn() -> Vec<([f64; 3], f64)>,
     /// Shape functions N_a and natural derivatives ∂N_a/∂ξ at ξ, as [`Element::shape`]
     /// gives them.
-    pub shape: fn(xi: [f64; 3]) -> (Vec<f64>, Vec<[f64; 3]>),
+    pub shape: fn(xi: [f64; 3]) -> ShapeValues,
     /// Local node indices of each face (a quadrilateral or a triangle), counter-clockwise
     /// seen from outside the cell: boundary extraction and face sets use them.
     pub faces: &'static [&'static [usize]],
@@ -161,15 +161,17 @@ pub trait Element<const N: usize, const G: usize>: Send + Sync + 'static {
     }
 }
 
+/// Shape functions N_a and their natural derivatives ∂N_a/∂ξ at one point, one entry per
+/// node.
+pub type ShapeValues = (Vec<f64>, Vec<[f64; 3]>);
+
 /// [`Element::gauss_rule`] of `E` as a list, for its [`ElementType`] row.
 pub fn gauss_rule_of<E: Element<N, G>, const N: usize, const G: usize>() -> Vec<([f64; 3], f64)> {
     E::gauss_rule().to_vec()
 }
 
 /// [`Element::shape`] of `E` at ξ as lists, for its [`ElementType`] row.
-pub fn shape_of<E: Element<N, G>, const N: usize, const G: usize>(
-    xi: [f64; 3],
-) -> (Vec<f64>, Vec<[f64; 3]>) {
+pub fn shape_of<E: Element<N, G>, const N: usize, const G: usize>(xi: [f64; 3]) -> ShapeValues {
     let (n, dn) = E::shape(xi);
     (n.to_vec(), dn.to_vec())
 }
