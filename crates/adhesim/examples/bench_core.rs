@@ -639,7 +639,7 @@ impl Driver {
 /// The element kernels of a full assembly (gather + element response with tangent) without
 /// the scatter into the global arrays; returns the summed energy.
 fn kernels_only(disc: &Discretisation, u: &[f64]) -> f64 {
-    let hexes = &disc.hexes;
+    let hexes = disc.hexes();
     (0..hexes.len())
         .into_par_iter()
         .with_min_len(64)
@@ -834,7 +834,7 @@ fn bench_size(cfg: &Config, n: usize) -> SizeResult {
 
     SizeResult {
         n,
-        elements: disc.hexes.len(),
+        elements: disc.hexes().len(),
         dofs: dim,
         nnz: pattern.nnz(),
         min_j: asm.min_j,

@@ -106,7 +106,7 @@ fn main() {
         Discretisation::with_formulations(&[(&mesh, material.clone())], &[f]).expect("valid mesh")
     };
     let (standard, fbar) = (disc(Formulation::Standard), disc(Formulation::FBar));
-    let ne = mesh.hexes.len() as f64;
+    let ne = mesh.hexes().len() as f64;
     let (standard_asm, fbar_asm, asm_ratio) = pool.install(|| {
         alternate(
             reps,
@@ -144,7 +144,7 @@ fn main() {
         tdisc(Formulation::Standard),
         tdisc(Formulation::AveragedNodalPressure),
     );
-    let nt = tets.tets.len() as f64;
+    let nt = tets.tets().len() as f64;
     let (linear_asm, anp_asm, tet_ratio) = pool.install(|| {
         alternate(
             reps,

@@ -1,31 +1,43 @@
 //! Global assembly over all bodies: one node numbering (bodies one after another), the
 //! sparsity pattern built once, element colouring so that the scatter runs in parallel
 //! without locks, and the constant mass matrix.
+//!
+//! The elements are kept in one [`ElementBlock`] per element type (all bodies together, in
+//! the order of [`crate::element::ELEMENT_TYPES`]). A block is generic over its
+//! [`Element`] type, so its loops over elements and Gauss points are compiled for that type;
+//! the discretisation holds the blocks as [`Block`] trait objects and dispatches once per
+//! block. The averaged-nodal-pressure formulation is assembled on the tet4 block, whose
+//! nodal patches couple its elements ([`crate::anp`]).
 
 use crate::anp::{
     add_volume_hessian, has_volumetric_split, IsochoricPart, NodalPatches, PatchState,
 };
-use crate::element::ElementResponse;
 use crate::element::{
-    consistent_mass, element_response_with_history, gauss_point_c, hex8_geometry, tet4_geometry,
-    DegenerateElement, GaussPoint,
+    element_cauchy_stress, element_response_with_history, gauss_point_c, DegenerateElement,
+    Element, ElementResponse, ElementType, GaussPoint, Stabilisation, Tet4, ELEMENT_TYPES,
 };
-use crate::fbar::{fbar_element_response_with_history, fbar_gauss_point_c, Formulation};
+use crate::fbar::{
+    fbar_cauchy_stress, fbar_element_response_with_history, fbar_gauss_point_c, Formulation,
+};
 use crate::linalg::BlockPattern;
 use crate::material::Hyperelastic;
 use crate::mesh::Mesh;
+use crate::Mat3;
 use rayon::prelude::*;
+use std::any::Any;
+use std::marker::PhantomData;
 use std::sync::Arc;
 
-/// Elements of one kind (N nodes, G Gauss points) with their reference data.
-pub struct ElementBlock<const N: usize, const G: usize> {
+/// Elements of one type `E` (N nodes, G Gauss points) with their reference data.
+pub struct ElementBlock<E, const N: usize, const G: usize> {
     /// Global node indices.
     pub nodes: Vec<[usize; N]>,
     /// Reference Gauss-point data.
     pub gauss: Vec<[GaussPoint<N>; G]>,
     /// Index of the owning body.
     pub body: Vec<usize>,
-    /// True for F-bar hexahedra and averaged-nodal-pressure tetrahedra ([`crate::anp`]),
+    /// True for the elements with the type's volumetric treatment switched on
+    /// ([`Element::STABILISATION`]: F-bar hexahedra, averaged-nodal-pressure tetrahedra),
     /// false for the standard fully integrated elements.
     pub fbar: Vec<bool>,
     /// Committed internal variables of viscoelastic elements, all Gauss points one after the
@@ -36,9 +48,15 @@ pub struct ElementBlock<const N: usize, const G: usize> {
     ranks: Vec<[[u32; N]; N]>,
     /// Element indices grouped so that no two elements of a group share a node.
     colours: Vec<Vec<usize>>,
+    element: PhantomData<fn() -> E>,
 }
 
-impl<const N: usize, const G: usize> ElementBlock<N, G> {
+/// An empty block of element type `E`, as the element-type table builds them.
+pub fn new_block<E: Element<N, G>, const N: usize, const G: usize>() -> Box<dyn Block> {
+    Box::new(ElementBlock::<E, N, G>::empty())
+}
+
+impl<E: Element<N, G>, const N: usize, const G: usize> ElementBlock<E, N, G> {
     fn empty() -> Self {
         ElementBlock {
             nodes: vec![],
@@ -48,6 +66,7 @@ impl<const N: usize, const G: usize> ElementBlock<N, G> {
             history: vec![],
             ranks: vec![],
             colours: vec![],
+            element: PhantomData,
         }
     }
     /// Number of elements.
@@ -65,7 +84,7 @@ impl<const N: usize, const G: usize> ElementBlock<N, G> {
 pub struct BadElement {
     /// Body index.
     pub body: usize,
-    /// Cell index within the body's mesh (hexes first, then tets).
+    /// Cell index within the body's mesh (mesh order: block after block).
     pub cell: usize,
     /// The offending reference Jacobian determinant.
     pub det: f64,
@@ -81,10 +100,9 @@ pub struct Discretisation {
     pub reference: Vec<[f64; 3]>,
     /// Material of each body.
     pub materials: Vec<Arc<dyn Hyperelastic>>,
-    /// Hexahedra.
-    pub hexes: ElementBlock<8, 8>,
-    /// Tetrahedra.
-    pub tets: ElementBlock<4, 1>,
+    /// The elements, one block per element type in the order of
+    /// [`crate::element::ELEMENT_TYPES`] (possibly empty).
+    pub blocks: Vec<Box<dyn Block>>,
     /// Nodal patches of the averaged-nodal-pressure tetrahedra (`None`: there are none).
     pub patches: Option<NodalPatches>,
     /// Upper-triangle block pattern of every system matrix.
@@ -146,8 +164,167 @@ fn colour_elements<const N: usize>(nodes: &[[usize; N]], num_nodes: usize) -> Ve
     colours
 }
 
-fn fill_ranks<const N: usize, const G: usize>(
-    block: &mut ElementBlock<N, G>,
+/// An element block seen without its element type: what the discretisation does with each
+/// block. Each call runs over all elements of the block in code compiled for its type.
+pub trait Block: Send + Sync + Any {
+    /// The element type of the block's elements.
+    fn element_type(&self) -> &'static ElementType;
+    /// Number of elements.
+    fn len(&self) -> usize;
+    /// True when the block holds no element.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// Index of the body owning element `e`.
+    fn body(&self, e: usize) -> usize;
+    /// Global node indices of element `e`.
+    fn element_nodes(&self, e: usize) -> &[usize];
+    /// True when element `e` uses the type's volumetric treatment.
+    fn stabilised(&self, e: usize) -> bool;
+    /// Adds an element of body `body` with global nodes `nodes`, reference coordinates `x`
+    /// [m], the body's formulation and material. Fails, adding nothing, when the reference
+    /// element is degenerate or inverted.
+    fn push(
+        &mut self,
+        nodes: &[usize],
+        x: &[[f64; 3]],
+        body: usize,
+        formulation: Formulation,
+        material: &dyn Hyperelastic,
+    ) -> Result<(), DegenerateElement>;
+    /// Pattern ranks of the element node pairs and the colouring of the elements.
+    fn fill_ranks(&mut self, pattern: &BlockPattern);
+    /// Adds the internal force, and the tangent when `with_tangent`, of the block's elements
+    /// at displacement `u` to `out`; returns their strain energy [J] and smallest det F.
+    fn assemble(
+        &self,
+        disc: &Discretisation,
+        u: &[f64],
+        out: &mut Assembled,
+        with_tangent: bool,
+    ) -> (f64, f64);
+    /// Advances the internal variables of the viscoelastic elements to the converged
+    /// displacement `u` at the end of a step of size `dt` [s].
+    fn commit(&mut self, materials: &[Arc<dyn Hyperelastic>], u: &[f64], dt: f64);
+    /// Committed internal variables of each element.
+    fn history(&self) -> &[Vec<f64>];
+    /// Committed internal variables of each element, mutable.
+    fn history_mut(&mut self) -> &mut [Vec<f64>];
+    /// Adds the mass matrix values [kg] of the block's elements (density [kg/m³] of each
+    /// body, consistent or row-sum lumped) to `m` (pattern order).
+    fn add_mass(&self, pattern: &BlockPattern, density: &[f64], lumped: bool, m: &mut [f64]);
+    /// Reference volume of the block's elements [m³].
+    fn volume(&self) -> f64;
+    /// Cauchy stress [Pa] averaged over element `e` and its mean volume ratio at `u`, with
+    /// the element's own kinematics (standard or F-bar).
+    fn cauchy_stress(&self, e: usize, u: &[f64], material: &dyn Hyperelastic) -> (Mat3, f64);
+    /// The block as [`Any`], to reach a block of a known type.
+    fn as_any(&self) -> &dyn Any;
+}
+
+impl<E: Element<N, G>, const N: usize, const G: usize> Block for ElementBlock<E, N, G> {
+    fn element_type(&self) -> &'static ElementType {
+        E::TYPE
+    }
+
+    fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    fn body(&self, e: usize) -> usize {
+        self.body[e]
+    }
+
+    fn element_nodes(&self, e: usize) -> &[usize] {
+        &self.nodes[e]
+    }
+
+    fn stabilised(&self, e: usize) -> bool {
+        self.fbar[e]
+    }
+
+    fn push(
+        &mut self,
+        nodes: &[usize],
+        x: &[[f64; 3]],
+        body: usize,
+        formulation: Formulation,
+        material: &dyn Hyperelastic,
+    ) -> Result<(), DegenerateElement> {
+        let nodes: [usize; N] = nodes.try_into().expect("node count of the element type");
+        let x: &[[f64; 3]; N] = x.try_into().expect("node count of the element type");
+        let gauss = E::geometry(x)?;
+        let stabilised = match E::STABILISATION {
+            Stabilisation::None => false,
+            Stabilisation::FBar => matches!(
+                formulation,
+                Formulation::FBar | Formulation::AveragedNodalPressure
+            ),
+            Stabilisation::NodalPressure => {
+                formulation == Formulation::AveragedNodalPressure && has_volumetric_split(material)
+            }
+        };
+        self.nodes.push(nodes);
+        self.gauss.push(gauss);
+        self.body.push(body);
+        self.fbar.push(stabilised);
+        self.history.push(history_for(material, G));
+        Ok(())
+    }
+
+    fn fill_ranks(&mut self, pattern: &BlockPattern) {
+        fill_ranks(self, pattern);
+    }
+
+    fn assemble(
+        &self,
+        disc: &Discretisation,
+        u: &[f64],
+        out: &mut Assembled,
+        with_tangent: bool,
+    ) -> (f64, f64) {
+        disc.assemble_block(self, u, out, with_tangent, None)
+    }
+
+    fn commit(&mut self, materials: &[Arc<dyn Hyperelastic>], u: &[f64], dt: f64) {
+        commit_block(self, materials, u, dt);
+    }
+
+    fn history(&self) -> &[Vec<f64>] {
+        &self.history
+    }
+
+    fn history_mut(&mut self) -> &mut [Vec<f64>] {
+        &mut self.history
+    }
+
+    fn add_mass(&self, pattern: &BlockPattern, density: &[f64], lumped: bool, m: &mut [f64]) {
+        mass_block(self, pattern, density, lumped, m);
+    }
+
+    fn volume(&self) -> f64 {
+        self.gauss
+            .iter()
+            .flat_map(|g| g.iter().map(|p| p.weight))
+            .sum()
+    }
+
+    fn cauchy_stress(&self, e: usize, u: &[f64], material: &dyn Hyperelastic) -> (Mat3, f64) {
+        let ue = self.nodes[e].map(|n| [u[3 * n], u[3 * n + 1], u[3 * n + 2]]);
+        if self.fbar[e] {
+            fbar_cauchy_stress(&self.gauss[e], &ue, material)
+        } else {
+            element_cauchy_stress(&self.gauss[e], &ue, material)
+        }
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+}
+
+fn fill_ranks<E, const N: usize, const G: usize>(
+    block: &mut ElementBlock<E, N, G>,
     pattern: &BlockPattern,
 ) {
     block.ranks = block
@@ -181,8 +358,8 @@ fn history_for(material: &dyn Hyperelastic, points: usize) -> Vec<f64> {
         .map_or(Vec::new(), |ve| vec![0.0; points * ve.history_len()])
 }
 
-fn commit_block<const N: usize, const G: usize>(
-    block: &mut ElementBlock<N, G>,
+fn commit_block<E, const N: usize, const G: usize>(
+    block: &mut ElementBlock<E, N, G>,
     materials: &[Arc<dyn Hyperelastic>],
     u: &[f64],
     dt: f64,
@@ -211,6 +388,50 @@ fn commit_block<const N: usize, const G: usize>(
         });
 }
 
+fn mass_block<E: Element<N, G>, const N: usize, const G: usize>(
+    block: &ElementBlock<E, N, G>,
+    pattern: &BlockPattern,
+    density: &[f64],
+    lumped: bool,
+    m: &mut [f64],
+) {
+    for e in 0..block.len() {
+        let me = E::mass(&block.gauss[e], density[block.body[e]]);
+        let en = &block.nodes[e];
+        for a in 0..N {
+            for b in 0..N {
+                let (na, nb) = (en[a], en[b]);
+                if lumped {
+                    if a == b {
+                        continue;
+                    }
+                    let r = block.ranks[e][a][a] as usize;
+                    for k in 0..3 {
+                        m[pattern.position(r, na, k, k)] += me[a][b];
+                    }
+                    continue;
+                }
+                if na > nb {
+                    continue;
+                }
+                let r = block.ranks[e][a][b] as usize;
+                for k in 0..3 {
+                    m[pattern.position(r, nb, k, k)] += me[a][b];
+                }
+            }
+            if lumped {
+                let r = block.ranks[e][a][a] as usize;
+                for k in 0..3 {
+                    m[pattern.position(r, en[a], k, k)] += me[a][a];
+                }
+            }
+        }
+    }
+}
+
+/// The tet4 block, on which the averaged-nodal-pressure formulation works.
+type Tet4Block = ElementBlock<Tet4, 4, 1>;
+
 impl Discretisation {
     /// Builds the discretisation of the given bodies (mesh, material). Fails with the list
     /// of degenerate or inverted reference elements.
@@ -218,7 +439,7 @@ impl Discretisation {
         Self::with_formulations(bodies, &[])
     }
 
-    /// As [`Discretisation::new`], with the element formulation of each body's hexahedra
+    /// As [`Discretisation::new`], with the element formulation of each body
     /// (bodies beyond the end of `formulations` use the standard element).
     pub fn with_formulations(
         bodies: &[(&Mesh, Arc<dyn Hyperelastic>)],
@@ -226,52 +447,34 @@ impl Discretisation {
     ) -> Result<Self, Vec<BadElement>> {
         let mut node_offset = Vec::new();
         let mut reference = Vec::new();
-        let mut hexes = ElementBlock::<8, 8>::empty();
-        let mut tets = ElementBlock::<4, 1>::empty();
+        let mut blocks: Vec<Box<dyn Block>> =
+            ELEMENT_TYPES.iter().map(|t| (t.new_block)()).collect();
         let mut bad = Vec::new();
-        for (bi, (mesh, _)) in bodies.iter().enumerate() {
+        for (bi, (mesh, material)) in bodies.iter().enumerate() {
             let off = reference.len();
             node_offset.push(off);
             reference.extend_from_slice(&mesh.nodes);
             let formulation = formulations.get(bi).copied().unwrap_or_default();
-            let fbar = matches!(
-                formulation,
-                Formulation::FBar | Formulation::AveragedNodalPressure
-            );
-            let anp = formulation == Formulation::AveragedNodalPressure
-                && has_volumetric_split(&*bodies[bi].1);
-            for (ci, h) in mesh.hexes.iter().enumerate() {
-                let x = h.map(|n| mesh.nodes[n]);
-                match hex8_geometry(&x) {
-                    Ok(g) => {
-                        hexes.nodes.push(h.map(|n| n + off));
-                        hexes.gauss.push(g);
-                        hexes.body.push(bi);
-                        hexes.fbar.push(fbar);
-                        hexes.history.push(history_for(&*bodies[bi].1, 8));
+            let mut ci = 0;
+            for cells in &mesh.blocks {
+                let block = &mut blocks[cells.element.index()];
+                let mut global = Vec::with_capacity(cells.element.nodes);
+                let mut x = Vec::with_capacity(cells.element.nodes);
+                for cell in cells.cells() {
+                    global.clear();
+                    global.extend(cell.iter().map(|&n| n + off));
+                    x.clear();
+                    x.extend(cell.iter().map(|&n| mesh.nodes[n]));
+                    if let Err(DegenerateElement { det }) =
+                        block.push(&global, &x, bi, formulation, &**material)
+                    {
+                        bad.push(BadElement {
+                            body: bi,
+                            cell: ci,
+                            det,
+                        });
                     }
-                    Err(DegenerateElement { det }) => bad.push(BadElement {
-                        body: bi,
-                        cell: ci,
-                        det,
-                    }),
-                }
-            }
-            for (ci, t) in mesh.tets.iter().enumerate() {
-                let x = t.map(|n| mesh.nodes[n]);
-                match tet4_geometry(&x) {
-                    Ok(g) => {
-                        tets.nodes.push(t.map(|n| n + off));
-                        tets.gauss.push(g);
-                        tets.body.push(bi);
-                        tets.fbar.push(anp);
-                        tets.history.push(history_for(&*bodies[bi].1, 1));
-                    }
-                    Err(DegenerateElement { det }) => bad.push(BadElement {
-                        body: bi,
-                        cell: mesh.hexes.len() + ci,
-                        det,
-                    }),
+                    ci += 1;
                 }
             }
         }
@@ -279,7 +482,10 @@ impl Discretisation {
             return Err(bad);
         }
         let num_nodes = reference.len();
-        let mut patches = tets.fbar.iter().any(|&a| a).then(|| {
+        let tets = blocks
+            .iter()
+            .find_map(|b| b.as_any().downcast_ref::<Tet4Block>());
+        let mut patches = tets.filter(|t| t.fbar.iter().any(|&a| a)).map(|tets| {
             let volume: Vec<f64> = tets.gauss.iter().map(|g| g[0].weight).collect();
             let kappa: Vec<f64> = tets
                 .body
@@ -290,15 +496,14 @@ impl Discretisation {
         });
         let pattern = BlockPattern::from_cells(
             num_nodes,
-            hexes
-                .nodes
+            blocks
                 .iter()
-                .map(|c| &c[..])
-                .chain(tets.nodes.iter().map(|c| &c[..]))
+                .flat_map(|b| (0..b.len()).map(|e| b.element_nodes(e)))
                 .chain(patches.iter().flat_map(|p| p.cells())),
         );
-        fill_ranks(&mut hexes, &pattern);
-        fill_ranks(&mut tets, &pattern);
+        for b in &mut blocks {
+            b.fill_ranks(&pattern);
+        }
         if let Some(p) = patches.as_mut() {
             p.fill_ranks(&pattern);
         }
@@ -308,12 +513,36 @@ impl Discretisation {
             num_nodes,
             reference,
             materials,
-            hexes,
-            tets,
+            blocks,
             patches,
             pattern,
             step_dt: 0.0,
         })
+    }
+
+    /// The block of element type `E` (every type of the table has one, possibly empty).
+    pub fn block<E: Element<N, G>, const N: usize, const G: usize>(
+        &self,
+    ) -> &ElementBlock<E, N, G> {
+        self.blocks
+            .iter()
+            .find_map(|b| b.as_any().downcast_ref())
+            .expect("every element type has a block")
+    }
+
+    /// The hex8 block.
+    pub fn hexes(&self) -> &ElementBlock<crate::element::Hex8, 8, 8> {
+        self.block()
+    }
+
+    /// The tet4 block.
+    pub fn tets(&self) -> &Tet4Block {
+        self.block()
+    }
+
+    /// Number of elements of all blocks.
+    pub fn num_cells(&self) -> usize {
+        self.blocks.iter().map(|b| b.len()).sum()
     }
 
     /// Sets the size Δt [s] of the step about to be solved (viscoelastic materials).
@@ -326,16 +555,16 @@ impl Discretisation {
     /// [`Discretisation::begin_step`].
     pub fn commit_step(&mut self, u: &[f64]) {
         let dt = self.step_dt;
-        commit_block(&mut self.hexes, &self.materials, u, dt);
-        commit_block(&mut self.tets, &self.materials, u, dt);
+        for b in &mut self.blocks {
+            b.commit(&self.materials, u, dt);
+        }
     }
 
     /// All internal variables, elements in order (for checkpoints).
     pub fn history(&self) -> Vec<f64> {
-        self.hexes
-            .history
+        self.blocks
             .iter()
-            .chain(&self.tets.history)
+            .flat_map(|b| b.history())
             .flatten()
             .copied()
             .collect()
@@ -345,10 +574,9 @@ impl Discretisation {
     /// nothing, when the length does not fit.
     pub fn set_history(&mut self, values: &[f64]) -> Result<(), String> {
         let n: usize = self
-            .hexes
-            .history
+            .blocks
             .iter()
-            .chain(&self.tets.history)
+            .flat_map(|b| b.history())
             .map(Vec::len)
             .sum();
         if values.len() != n {
@@ -358,7 +586,7 @@ impl Discretisation {
             ));
         }
         let mut k = 0;
-        for h in self.hexes.history.iter_mut().chain(&mut self.tets.history) {
+        for h in self.blocks.iter_mut().flat_map(|b| b.history_mut()) {
             let len = h.len();
             h.copy_from_slice(&values[k..k + len]);
             k += len;
@@ -383,42 +611,59 @@ impl Discretisation {
             energy: 0.0,
             min_j: f64::INFINITY,
         };
-        let (e1, j1) = self.assemble_block(&self.hexes, u, &mut out, with_tangent, None);
-        let (e2, j2) = match &self.patches {
-            None => self.assemble_block(&self.tets, u, &mut out, with_tangent, None),
-            Some(patches) => {
-                let state = patches.state(&self.tets.nodes, &self.tets.gauss, u);
-                // The volumetric part of each element: p̄_e ∂v_e/∂u and p̄_e ∂²v_e/∂u².
-                let add_pressure = |e: usize, r: &mut ElementResponse<4>| {
-                    let Some((v, dv)) = &state.volume[e] else {
-                        return;
-                    };
-                    let p = state.element_pressure[e];
-                    for (fa, dva) in r.force.iter_mut().zip(dv) {
-                        for (f, d) in fa.iter_mut().zip(dva.iter()) {
-                            *f += p * d;
-                        }
-                    }
-                    if let Some(k) = r.tangent.as_mut() {
-                        add_volume_hessian(k, dv, *v, p);
-                    }
-                };
-                let (e, j) =
-                    self.assemble_block(&self.tets, u, &mut out, with_tangent, Some(&add_pressure));
-                if with_tangent {
-                    patches.add_patch_tangent(&state, &self.pattern, &mut out.tangent);
+        for block in &self.blocks {
+            let nodal_pressure = self
+                .patches
+                .as_ref()
+                .zip(block.as_any().downcast_ref::<Tet4Block>());
+            let (e, j) = match nodal_pressure {
+                Some((patches, tets)) => {
+                    self.assemble_nodal_pressure(tets, patches, u, &mut out, with_tangent)
                 }
-                (e + state.energy, j)
-            }
-        };
-        out.energy = e1 + e2;
-        out.min_j = j1.min(j2);
+                None => block.assemble(self, u, &mut out, with_tangent),
+            };
+            out.energy += e;
+            out.min_j = out.min_j.min(j);
+        }
         out
     }
 
-    fn assemble_block<const N: usize, const G: usize>(
+    /// The tet4 block with its averaged-nodal-pressure elements: their isochoric response
+    /// plus the volumetric part of their nodal patches.
+    fn assemble_nodal_pressure(
         &self,
-        block: &ElementBlock<N, G>,
+        tets: &Tet4Block,
+        patches: &NodalPatches,
+        u: &[f64],
+        out: &mut Assembled,
+        with_tangent: bool,
+    ) -> (f64, f64) {
+        let state = patches.state(&tets.nodes, &tets.gauss, u);
+        // The volumetric part of each element: p̄_e ∂v_e/∂u and p̄_e ∂²v_e/∂u².
+        let add_pressure = |e: usize, r: &mut ElementResponse<4>| {
+            let Some((v, dv)) = &state.volume[e] else {
+                return;
+            };
+            let p = state.element_pressure[e];
+            for (fa, dva) in r.force.iter_mut().zip(dv) {
+                for (f, d) in fa.iter_mut().zip(dva.iter()) {
+                    *f += p * d;
+                }
+            }
+            if let Some(k) = r.tangent.as_mut() {
+                add_volume_hessian(k, dv, *v, p);
+            }
+        };
+        let (e, j) = self.assemble_block(tets, u, out, with_tangent, Some(&add_pressure));
+        if with_tangent {
+            patches.add_patch_tangent(&state, &self.pattern, &mut out.tangent);
+        }
+        (e + state.energy, j)
+    }
+
+    fn assemble_block<E, const N: usize, const G: usize>(
+        &self,
+        block: &ElementBlock<E, N, G>,
         u: &[f64],
         out: &mut Assembled,
         with_tangent: bool,
@@ -505,9 +750,27 @@ impl Discretisation {
     /// The volumetric state of the averaged-nodal-pressure tetrahedra at `u` (`None`: there
     /// are none).
     pub fn patch_state(&self, u: &[f64]) -> Option<PatchState> {
-        self.patches
-            .as_ref()
-            .map(|p| p.state(&self.tets.nodes, &self.tets.gauss, u))
+        self.patches.as_ref().map(|p| {
+            let tets = self.tets();
+            p.state(&tets.nodes, &tets.gauss, u)
+        })
+    }
+
+    /// Cauchy stress [Pa] and volume ratio of element `e` of block `block` at `u`: for the
+    /// averaged-nodal-pressure tetrahedra as [`Discretisation::tet_cauchy_stress`], for the
+    /// others with the element's own kinematics.
+    pub fn cell_cauchy_stress(
+        &self,
+        block: usize,
+        e: usize,
+        u: &[f64],
+        state: Option<&PatchState>,
+    ) -> (Mat3, f64) {
+        let b = &self.blocks[block];
+        if b.as_any().is::<Tet4Block>() {
+            return self.tet_cauchy_stress(e, u, state);
+        }
+        b.cauchy_stress(e, u, &*self.materials[b.body(e)])
     }
 
     /// Cauchy stress [Pa] and volume ratio of tetrahedron `e` at `u`. For an
@@ -519,25 +782,22 @@ impl Discretisation {
         e: usize,
         u: &[f64],
         state: Option<&PatchState>,
-    ) -> (crate::Mat3, f64) {
-        let en = &self.tets.nodes[e];
+    ) -> (Mat3, f64) {
+        let tets = self.tets();
+        let en = &tets.nodes[e];
         let ue = en.map(|n| [u[3 * n], u[3 * n + 1], u[3 * n + 2]]);
-        let mat = &*self.materials[self.tets.body[e]];
+        let mat = &*self.materials[tets.body[e]];
         match (state, &self.patches) {
             (Some(st), Some(p)) if p.active[e] => {
-                let (iso, _) = crate::element::element_cauchy_stress(
-                    &self.tets.gauss[e],
-                    &ue,
-                    &IsochoricPart(mat),
-                );
+                let (iso, _) = element_cauchy_stress(&tets.gauss[e], &ue, &IsochoricPart(mat));
                 let j = en
                     .iter()
                     .map(|&n| st.nodal_ratio[p.patch_of[n] as usize])
                     .sum::<f64>()
                     / 4.0;
-                (iso + crate::Mat3::identity() * st.element_pressure[e], j)
+                (iso + Mat3::identity() * st.element_pressure[e], j)
             }
-            _ => crate::element::element_cauchy_stress(&self.tets.gauss[e], &ue, mat),
+            _ => element_cauchy_stress(&tets.gauss[e], &ue, mat),
         }
     }
 
@@ -545,66 +805,14 @@ impl Discretisation {
     /// density [kg/m³] of each body.
     pub fn mass(&self, density: &[f64], lumped: bool) -> Vec<f64> {
         let mut m = vec![0.0; self.pattern.nnz()];
-        self.mass_block(&self.hexes, density, lumped, &mut m);
-        self.mass_block(&self.tets, density, lumped, &mut m);
-        m
-    }
-
-    fn mass_block<const N: usize, const G: usize>(
-        &self,
-        block: &ElementBlock<N, G>,
-        density: &[f64],
-        lumped: bool,
-        m: &mut [f64],
-    ) {
-        for e in 0..block.len() {
-            let me = consistent_mass(&block.gauss[e], density[block.body[e]]);
-            let en = &block.nodes[e];
-            for a in 0..N {
-                for b in 0..N {
-                    let (na, nb) = (en[a], en[b]);
-                    if lumped {
-                        if a == b {
-                            continue;
-                        }
-                        let r = block.ranks[e][a][a] as usize;
-                        for k in 0..3 {
-                            m[self.pattern.position(r, na, k, k)] += me[a][b];
-                        }
-                        continue;
-                    }
-                    if na > nb {
-                        continue;
-                    }
-                    let r = block.ranks[e][a][b] as usize;
-                    for k in 0..3 {
-                        m[self.pattern.position(r, nb, k, k)] += me[a][b];
-                    }
-                }
-                if lumped {
-                    let r = block.ranks[e][a][a] as usize;
-                    for k in 0..3 {
-                        m[self.pattern.position(r, en[a], k, k)] += me[a][a];
-                    }
-                }
-            }
+        for b in &self.blocks {
+            b.add_mass(&self.pattern, density, lumped, &mut m);
         }
+        m
     }
 
     /// Reference volume of all elements [m³].
     pub fn volume(&self) -> f64 {
-        let v1: f64 = self
-            .hexes
-            .gauss
-            .iter()
-            .flat_map(|g| g.iter().map(|p| p.weight))
-            .sum();
-        let v2: f64 = self
-            .tets
-            .gauss
-            .iter()
-            .flat_map(|g| g.iter().map(|p| p.weight))
-            .sum();
-        v1 + v2
+        self.blocks.iter().map(|b| b.volume()).sum()
     }
 }

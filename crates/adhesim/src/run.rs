@@ -204,7 +204,7 @@ pub fn run_with(
         newton_iterations: 0,
         frames: 0,
         nodes: stepper.disc.num_nodes,
-        cells: stepper.disc.hexes.len() + stepper.disc.tets.len(),
+        cells: stepper.disc.num_cells(),
         wall_time: 0.0,
         resumed_from: None,
         checkpoint: None,

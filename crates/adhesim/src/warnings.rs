@@ -60,10 +60,7 @@ fn smallest_edge(mesh: &Mesh) -> f64 {
             }
         }
     };
-    for c in &mesh.hexes {
-        visit(c);
-    }
-    for c in &mesh.tets {
+    for (_, c) in mesh.cells() {
         visit(c);
     }
     h

@@ -53,7 +53,7 @@ fn shaken_tet_cube(n: usize, shake: f64, seed: u64) -> (Mesh, Vec<usize>) {
 fn split_mesh_is_conforming_and_keeps_the_volume() {
     let hexes = generate::block([2.0, 1.0, 0.5], [4, 3, 2]);
     let tets = hexes.split_hexes_into_tets();
-    assert_eq!(tets.tets.len(), 6 * hexes.hexes.len());
+    assert_eq!(tets.tets().len(), 6 * hexes.hexes().len());
     let material: Arc<dyn Hyperelastic> =
         Arc::new(UncoupledNeoHookean::from_young_poisson(1.0, 0.3));
     let disc = Discretisation::new(&[(&tets, material)]).expect("positive tetrahedra");
@@ -134,13 +134,13 @@ fn patch_reproduces_a_large_homogeneous_deformation() {
 /// nodes' J, the volume change their material sees).
 fn volume_change(disc: &Discretisation, u: &[f64]) -> (f64, f64) {
     let patches: &NodalPatches = disc.patches.as_ref().expect("anp elements");
-    let state = patches.state(&disc.tets.nodes, &disc.tets.gauss, u);
+    let state = patches.state(&disc.tets().nodes, &disc.tets().gauss, u);
     let nodal = state
         .nodal_ratio
         .iter()
         .fold(0.0f64, |m, j| m.max((j - 1.0).abs()));
     let element = disc
-        .tets
+        .tets()
         .nodes
         .iter()
         .map(|t| {

@@ -186,7 +186,7 @@ fn cooks_membrane_converges() {
 /// Largest |θ − 1| over the elements, θ = v/V their volume ratio.
 fn volume_change(s: &Stepper, mesh: &Mesh) -> f64 {
     let mut worst: f64 = 0.0;
-    for h in &mesh.hexes {
+    for h in mesh.hexes() {
         let x = h.map(|n| mesh.nodes[n]);
         let u = h.map(|n| [s.state.u[3 * n], s.state.u[3 * n + 1], s.state.u[3 * n + 2]]);
         let gps = adhesim::element::hex8_geometry(&x).unwrap();

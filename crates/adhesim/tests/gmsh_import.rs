@@ -34,7 +34,7 @@ fn body(path: &Path, volumes: Option<&[&str]>) -> GmshBody {
 
 /// Volume of every cell (hexes by 2 × 2 × 2 Gauss, tets exactly).
 fn cell_volumes(mesh: &Mesh) -> Vec<f64> {
-    let hexes = mesh.hexes.iter().map(|h| {
+    let hexes = mesh.hexes().iter().map(|h| {
         hex8_geometry(&h.map(|n| mesh.nodes[n]))
             .expect("valid hex")
             .iter()
@@ -42,7 +42,7 @@ fn cell_volumes(mesh: &Mesh) -> Vec<f64> {
             .sum::<f64>()
     });
     let tets = mesh
-        .tets
+        .tets()
         .iter()
         .map(|t| tet4_geometry(&t.map(|n| mesh.nodes[n])).expect("valid tet")[0].weight);
     hexes.chain(tets).collect()
@@ -54,8 +54,7 @@ fn ascii_and_binary_files_give_the_same_mesh() {
     let b = gmsh::read(&binary_path()).unwrap();
     assert_eq!(a.nodes, b.nodes);
     assert_eq!(a.node_tags, b.node_tags);
-    assert_eq!(a.hexes, b.hexes);
-    assert_eq!(a.tets, b.tets);
+    assert_eq!(a.volumes, b.volumes);
     assert_eq!(a.quads, b.quads);
     assert_eq!(a.tris, b.tris);
     assert_eq!(a.physical_names, b.physical_names);
@@ -72,8 +71,8 @@ fn shipped_mesh_counts_sets_and_volumes() {
     let m = &all.mesh;
     // The layer is 12 × 12 × 2 hexahedra (13 × 13 × 3 nodes); the hemisphere's tetrahedra
     // come from Gmsh's unstructured mesher.
-    assert_eq!(m.hexes.len(), 288);
-    assert_eq!(m.tets.len(), 788);
+    assert_eq!(m.hexes().len(), 288);
+    assert_eq!(m.tets().len(), 788);
     assert_eq!(m.num_nodes(), 754);
     assert_eq!(all.cell_tags.len(), m.num_cells());
     assert_eq!(
@@ -102,8 +101,11 @@ fn shipped_mesh_counts_sets_and_volumes() {
     let layer = body(&ascii_path(), Some(&["layer"]));
     assert_eq!(ball.mesh.num_nodes() + layer.mesh.num_nodes(), 754);
     assert_eq!(layer.mesh.num_nodes(), 13 * 13 * 3);
-    assert_eq!((ball.mesh.hexes.len(), ball.mesh.tets.len()), (0, 788));
-    assert_eq!((layer.mesh.hexes.len(), layer.mesh.tets.len()), (288, 0));
+    assert_eq!((ball.mesh.hexes().len(), ball.mesh.tets().len()), (0, 788));
+    assert_eq!(
+        (layer.mesh.hexes().len(), layer.mesh.tets().len()),
+        (288, 0)
+    );
     assert_eq!(
         names(&ball.mesh.node_sets),
         ["ball", "ball_surface", "ball_top"]
@@ -367,7 +369,7 @@ fn a_gmsh_hexahedron_has_positive_volume_and_outward_faces() {
     // physical groups of dimension 0, 2 and 3.
     for file in ["tiny_cube.msh", "tiny_cube_binary.msh"] {
         let b = body(&data(file), None);
-        assert_eq!((b.mesh.num_nodes(), b.mesh.hexes.len()), (8, 1), "{file}");
+        assert_eq!((b.mesh.num_nodes(), b.mesh.hexes().len()), (8, 1), "{file}");
         assert!(quality::inverted_cells(&b.mesh).is_empty());
         assert!((quality::cell_min_jacobian_ratio(&b.mesh)[0] - 1.0).abs() < 1e-12);
         assert!((cell_volumes(&b.mesh)[0] - 1.0).abs() < 1e-12);

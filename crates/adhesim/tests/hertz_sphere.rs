@@ -128,9 +128,9 @@ fn graded_octant(c: f64, k: usize, growth: f64, outer: f64) -> Mesh {
     }
     let mut mesh = Mesh {
         nodes,
-        hexes,
         ..Mesh::default()
     };
+    mesh.add_cells(&adhesim::element::HEX8, hexes);
     let faces = mesh.boundary_faces();
     let pick = |on: &dyn Fn([f64; 3]) -> bool| -> Vec<Face> {
         faces

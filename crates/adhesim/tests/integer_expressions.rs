@@ -33,7 +33,7 @@ fn integer_keys_take_expressions() {
     let p = adhesim::scenario::parse(&text, Path::new("ints.toml")).unwrap();
     let mesh = &p.bodies[0].mesh;
     // 4 × 2 × 2 hexahedra on 5 × 3 × 3 nodes.
-    assert_eq!(mesh.hexes.len(), 16);
+    assert_eq!(mesh.hexes().len(), 16);
     assert_eq!(mesh.num_nodes(), 45);
     assert_eq!(p.bodies[0].density, 1000.0);
 }

@@ -16,6 +16,7 @@
 //! corner angle far from 90°.
 
 use super::{Face, Mesh};
+use crate::element::HEX8;
 use std::collections::HashMap;
 use std::f64::consts::FRAC_PI_4;
 
@@ -62,9 +63,9 @@ pub fn block(size: [f64; 3], divisions: [usize; 3]) -> Mesh {
         nodes: grid_points(divisions)
             .map(|q| [size[0] * q[0], size[1] * q[1], size[2] * q[2]])
             .collect(),
-        hexes: grid_hexes(divisions),
         ..Mesh::default()
     };
+    mesh.add_cells(&HEX8, grid_hexes(divisions));
     let [lx, ly, lz] = size;
     let on = |axis: usize, value: f64| {
         let tol = REL_TOL * size[axis];
@@ -232,19 +233,19 @@ pub fn quarter_hemisphere(radius: f64, n: usize) -> Mesh {
 fn ball_octant_hexes(grid: &BallOGrid, n: usize) -> Mesh {
     let mut merger = NodeMerger::new(REL_TOL * grid.radius);
     let mut mesh = Mesh::default();
-    add_hex_block(&mut merger, &mut mesh.hexes, [n; 3], |q| grid.core(q));
+    let mut hexes = Vec::new();
+    add_hex_block(&mut merger, &mut hexes, [n; 3], |q| grid.core(q));
     for axis in 0..3 {
-        add_hex_block(&mut merger, &mut mesh.hexes, [n; 3], |q| {
-            grid.shell(axis, q)
-        });
+        add_hex_block(&mut merger, &mut hexes, [n; 3], |q| grid.shell(axis, q));
     }
+    mesh.add_cells(&HEX8, hexes);
     // The blocks are built in the octant y ≥ 0; mirror to y ≤ 0 and restore the orientation.
     mesh.nodes = merger
         .into_nodes()
         .into_iter()
         .map(|p| [p[0], -p[1], p[2]].map(|x| snap_zero(x, grid.radius)))
         .collect();
-    for h in &mut mesh.hexes {
+    for h in mesh.hexes_mut() {
         *h = [h[0], h[3], h[2], h[1], h[4], h[7], h[6], h[5]];
     }
     mesh
@@ -373,22 +374,19 @@ fn extrude(plane: &PlaneMesh, thickness: f64) -> Mesh {
         mesh.nodes
             .extend(plane.nodes.iter().map(|p| [p[0], p[1], z]));
     }
-    mesh.hexes = plane
-        .quads
-        .iter()
-        .map(|q| {
-            [
-                q[0],
-                q[1],
-                q[2],
-                q[3],
-                q[0] + n,
-                q[1] + n,
-                q[2] + n,
-                q[3] + n,
-            ]
-        })
-        .collect();
+    let hexes = plane.quads.iter().map(|q| {
+        [
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            q[0] + n,
+            q[1] + n,
+            q[2] + n,
+            q[3] + n,
+        ]
+    });
+    mesh.add_cells(&HEX8, hexes);
     mesh
 }
 
@@ -764,7 +762,7 @@ mod tests {
     }
 
     fn volume(mesh: &Mesh) -> f64 {
-        (0..mesh.hexes.len()).map(|c| hex_volume(mesh, c)).sum()
+        (0..mesh.hexes().len()).map(|c| hex_volume(mesh, c)).sum()
     }
 
     /// Pairs of distinct nodes closer than `tol` (max-norm), found with a hash grid.
@@ -797,7 +795,7 @@ mod tests {
         assert!(inverted_cells(mesh).is_empty(), "inverted cells");
         assert!(close_node_pairs(&mesh.nodes, 1e-6 * scale).is_empty());
         let mut used = vec![false; mesh.nodes.len()];
-        for h in &mesh.hexes {
+        for h in mesh.hexes() {
             for &i in h {
                 used[i] = true;
             }

@@ -15,12 +15,14 @@
 //!
 //!    Groups without a name are called `physical_<tag>`.
 //!
-//! Element types: hex8 (Gmsh type 5) and tet4 (4) become cells; quad4 (3) and tri3 (2) are
-//! faces; points (15) and lines (1, 8, 26, 27, 28) only feed node sets. Gmsh's hex8 and tet4
-//! node orders are adhesim's (VTK) orders, so cells are taken as they are. Higher-order and
-//! other volume or surface elements are rejected.
+//! Element types: the volume types of the element-type table
+//! ([`crate::element::ELEMENT_TYPES`], found by their Gmsh type number: hex8 (Gmsh type 5)
+//! and tet4 (4)) become cells; quad4 (3) and tri3 (2) are faces; points (15) and lines (1, 8,
+//! 26, 27, 28) only feed node sets. Gmsh's node orders of these types are adhesim's (VTK)
+//! orders, so cells are taken as they are. Other volume or surface elements are rejected.
 
 use super::{Face, Mesh};
+use crate::element::{ElementType, ELEMENT_TYPES};
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -74,6 +76,68 @@ pub struct Element<const N: usize> {
     pub nodes: [usize; N],
 }
 
+/// The volume elements of one type in file order: Gmsh tag, entity and nodes of each.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VolumeElements {
+    /// The element type.
+    pub element: &'static ElementType,
+    /// Gmsh tag of each element.
+    pub tags: Vec<u64>,
+    /// Tag of the geometric volume holding each element.
+    pub entities: Vec<i32>,
+    /// Node indices into [`MshFile::nodes`], `element.nodes` per element.
+    pub nodes: Vec<usize>,
+}
+
+impl VolumeElements {
+    /// Number of elements.
+    pub fn len(&self) -> usize {
+        self.tags.len()
+    }
+
+    /// True when there is no element.
+    pub fn is_empty(&self) -> bool {
+        self.tags.is_empty()
+    }
+
+    /// Node indices of element `i`.
+    pub fn element_nodes(&self, i: usize) -> &[usize] {
+        let n = self.element.nodes;
+        &self.nodes[n * i..n * (i + 1)]
+    }
+}
+
+impl MshFile {
+    /// The volume elements of type `element` (`None`: the file has none).
+    pub fn volume_elements(&self, element: &ElementType) -> Option<&VolumeElements> {
+        self.volumes.iter().find(|v| v.element == element)
+    }
+
+    fn volume_block_mut(&mut self, element: &'static ElementType) -> &mut VolumeElements {
+        let i = match self.volumes.iter().position(|v| v.element == element) {
+            Some(i) => i,
+            None => {
+                let at = self
+                    .volumes
+                    .iter()
+                    .position(|v| v.element.index() > element.index())
+                    .unwrap_or(self.volumes.len());
+                self.volumes.insert(
+                    at,
+                    VolumeElements {
+                        element,
+                        tags: Vec::new(),
+                        entities: Vec::new(),
+                        nodes: Vec::new(),
+                    },
+                );
+                at
+            }
+        };
+        &mut self.volumes[i]
+    }
+}
+
 /// The content of an MSH 4.1 file that adhesim uses.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MshFile {
@@ -83,10 +147,9 @@ pub struct MshFile {
     pub nodes: Vec<[f64; 3]>,
     /// Gmsh tag of each node.
     pub node_tags: Vec<u64>,
-    /// Hex8 elements.
-    pub hexes: Vec<Element<8>>,
-    /// Tet4 elements.
-    pub tets: Vec<Element<4>>,
+    /// Volume elements, one block per element type in the order of
+    /// [`crate::element::ELEMENT_TYPES`] (no empty blocks).
+    pub volumes: Vec<VolumeElements>,
     /// Quad4 elements.
     pub quads: Vec<Element<4>>,
     /// Tri3 elements.
@@ -104,7 +167,7 @@ pub struct MshFile {
 pub struct GmshBody {
     /// The mesh with its named node and face sets.
     pub mesh: Mesh,
-    /// Gmsh tag of each cell (hexes first, then tets, as in [`super::quality`]).
+    /// Gmsh tag of each cell (mesh order: block after block, as in [`super::quality`]).
     pub cell_tags: Vec<u64>,
     /// Gmsh tag of each node.
     pub node_tags: Vec<u64>,
@@ -224,10 +287,11 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<MshFile, GmshError> {
     if !seen_elements {
         return Err(p.err_here("the file holds no $Elements section"));
     }
-    if msh.hexes.is_empty() && msh.tets.is_empty() {
-        return Err(p.err_here(
-            "the file holds no volume elements (hex8 or tet4): mesh the volumes in 3D (gmsh -3)",
-        ));
+    if msh.volumes.iter().all(VolumeElements::is_empty) {
+        return Err(p.err_here(format!(
+            "the file holds no volume elements ({}): mesh the volumes in 3D (gmsh -3)",
+            volume_type_names(" or ")
+        )));
     }
     // Name every physical group used by an entity.
     for phys in msh
@@ -243,7 +307,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<MshFile, GmshError> {
 }
 
 /// Gmsh element types adhesim knows the node count of: (type, name, nodes, dimension).
-const ELEMENT_TYPES: &[(i32, &str, usize, i32)] = &[
+const GMSH_ELEMENT_TYPES: &[(i32, &str, usize, i32)] = &[
     (1, "line2", 2, 1),
     (2, "tri3", 3, 2),
     (3, "quad4", 4, 2),
@@ -278,8 +342,17 @@ const ELEMENT_TYPES: &[(i32, &str, usize, i32)] = &[
     (93, "hex125", 125, 3),
 ];
 
-fn element_type(t: i32) -> Option<(&'static str, usize, i32)> {
+/// The names of the volume element types adhesim reads, joined by `sep`.
+fn volume_type_names(sep: &str) -> String {
     ELEMENT_TYPES
+        .iter()
+        .map(|t| t.name)
+        .collect::<Vec<_>>()
+        .join(sep)
+}
+
+fn element_type(t: i32) -> Option<(&'static str, usize, i32)> {
+    GMSH_ELEMENT_TYPES
         .iter()
         .find(|e| e.0 == t)
         .map(|e| (e.1, e.2, e.3))
@@ -724,8 +797,19 @@ impl Parser<'_> {
             let at_type = self.mark();
             let etype = self.int("the element type")?;
             let Some((name, nn, edim)) = element_type(etype) else {
+                let volumes: Vec<String> = ELEMENT_TYPES
+                    .iter()
+                    .enumerate()
+                    .map(|(i, t)| {
+                        if i == 0 {
+                            format!("{} (Gmsh type {})", t.name, t.gmsh_type)
+                        } else {
+                            format!("{} ({})", t.name, t.gmsh_type)
+                        }
+                    })
+                    .collect();
                 return Err(self.err_at(at_type,
-                    format!("element type {etype} is not known: adhesim reads hex8 (Gmsh type 5) and tet4 (4) volumes, quad4 (3) and tri3 (2) faces"),
+                    format!("element type {etype} is not known: adhesim reads {} volumes, quad4 (3) and tri3 (2) faces", volumes.join(" and ")),
                 ));
             };
             if edim != dim {
@@ -733,12 +817,16 @@ impl Parser<'_> {
                     format!("{name} (Gmsh type {etype}) in a block of dimension {dim}: expected dimension {edim}"),
                 ));
             }
-            let supported = (2..=5).contains(&etype) || dim <= 1;
+            let volume = ElementType::from_gmsh(etype);
+            let supported = matches!(etype, 2 | 3) || volume.is_some() || dim <= 1;
             if !supported {
                 let fix = if matches!(etype, 6 | 7) {
-                    "adhesim meshes hold hex8 and tet4 volumes only: remesh with hexahedra or tetrahedra"
+                    format!(
+                        "adhesim meshes hold {} volumes only: remesh with hexahedra or tetrahedra",
+                        volume_type_names(" and ")
+                    )
                 } else {
-                    "remesh with first-order elements (Mesh.ElementOrder = 1)"
+                    "remesh with first-order elements (Mesh.ElementOrder = 1)".to_string()
                 };
                 return Err(self.err_at(
                     at_type,
@@ -753,7 +841,7 @@ impl Parser<'_> {
                     format!("the element blocks hold more elements than the {total} announced"),
                 ));
             }
-            let mut nodes = [0usize; 8];
+            let mut nodes = vec![0usize; nn];
             for _ in 0..n {
                 let tag = self.size("an element tag")?;
                 for slot in nodes.iter_mut().take(nn) {
@@ -766,6 +854,13 @@ impl Parser<'_> {
                         )
                     })?;
                 }
+                if let Some(element) = volume {
+                    let block = msh.volume_block_mut(element);
+                    block.tags.push(tag);
+                    block.entities.push(entity);
+                    block.nodes.extend_from_slice(&nodes);
+                    continue;
+                }
                 match etype {
                     2 => msh.tris.push(Element {
                         tag,
@@ -777,12 +872,6 @@ impl Parser<'_> {
                         entity,
                         nodes: [nodes[0], nodes[1], nodes[2], nodes[3]],
                     }),
-                    4 => msh.tets.push(Element {
-                        tag,
-                        entity,
-                        nodes: [nodes[0], nodes[1], nodes[2], nodes[3]],
-                    }),
-                    5 => msh.hexes.push(Element { tag, entity, nodes }),
                     _ => {
                         // Points and lines: only their end nodes matter (node sets).
                         let used = if dim == 0 { 1 } else { 2 };
@@ -876,24 +965,29 @@ impl MshFile {
                 }
             }
         }
-        let hexes: Vec<&Element<8>> = self.hexes.iter().filter(|e| selected(e.entity)).collect();
-        let tets: Vec<&Element<4>> = self.tets.iter().filter(|e| selected(e.entity)).collect();
-        if hexes.is_empty() && tets.is_empty() {
+        // The selected elements of each volume block: (block, element index).
+        let chosen: Vec<(&VolumeElements, usize)> = self
+            .volumes
+            .iter()
+            .flat_map(|v| {
+                (0..v.len())
+                    .filter(|&i| selected(v.entities[i]))
+                    .map(move |i| (v, i))
+            })
+            .collect();
+        if chosen.is_empty() {
             return Err(self.err(match volumes {
                 Some(sel) => format!(
-                    "the physical volumes {} hold no hex8 or tet4 elements",
-                    list(sel)
+                    "the physical volumes {} hold no {} elements",
+                    list(sel),
+                    volume_type_names(" or ")
                 ),
-                None => "the file holds no hex8 or tet4 elements".into(),
+                None => format!("the file holds no {} elements", volume_type_names(" or ")),
             }));
         }
         // Keep the nodes the cells use, in file order.
         let mut new_id = vec![usize::MAX; self.nodes.len()];
-        for &i in hexes
-            .iter()
-            .flat_map(|e| e.nodes.iter())
-            .chain(tets.iter().flat_map(|e| e.nodes.iter()))
-        {
+        for &i in chosen.iter().flat_map(|&(v, e)| v.element_nodes(e)) {
             new_id[i] = 0;
         }
         let mut mesh = Mesh::default();
@@ -906,35 +1000,23 @@ impl MshFile {
             }
         }
         let map = |i: usize| new_id[i];
-        mesh.hexes = hexes.iter().map(|e| e.nodes.map(map)).collect();
-        mesh.tets = tets.iter().map(|e| e.nodes.map(map)).collect();
-        let cell_tags: Vec<u64> = hexes
-            .iter()
-            .map(|e| e.tag)
-            .chain(tets.iter().map(|e| e.tag))
-            .collect();
+        for &(v, e) in &chosen {
+            let conn = mesh.connectivity_mut(v.element);
+            conn.extend(v.element_nodes(e).iter().map(|&i| map(i)));
+        }
+        let cell_tags: Vec<u64> = chosen.iter().map(|&(v, e)| v.tags[e]).collect();
         // Physical volumes: cell sets and node sets.
         let mut cell_sets: BTreeMap<String, Vec<usize>> = BTreeMap::new();
-        let entities = hexes
-            .iter()
-            .map(|e| e.entity)
-            .chain(tets.iter().map(|e| e.entity));
+        let entities = chosen.iter().map(|&(v, e)| v.entities[e]);
         for (c, entity) in entities.enumerate() {
             for g in self.groups(3, entity) {
                 cell_sets.entry(g.to_string()).or_default().push(c);
             }
         }
-        let nh = mesh.hexes.len();
         for (name, cells) in &cell_sets {
             let nodes = cells
                 .iter()
-                .flat_map(|&c| {
-                    if c < nh {
-                        mesh.hexes[c].to_vec()
-                    } else {
-                        mesh.tets[c - nh].to_vec()
-                    }
-                })
+                .flat_map(|&c| mesh.cell(c).1.to_vec())
                 .collect();
             mesh.set_nodes(name, nodes);
         }
@@ -1068,7 +1150,7 @@ $EndElements
     fn gmsh_hex_order_is_adhesim_order() {
         let msh = parse_str(CUBE).unwrap();
         let body = msh.body(None).unwrap();
-        assert_eq!(body.mesh.hexes.len(), 1);
+        assert_eq!(body.mesh.hexes().len(), 1);
         assert!(quality::inverted_cells(&body.mesh).is_empty());
         assert!((quality::hex_volume(&body.mesh, 0) - 1.0).abs() < 1e-14);
         assert!((quality::cell_min_jacobian_ratio(&body.mesh)[0] - 1.0).abs() < 1e-14);
@@ -1088,7 +1170,7 @@ $EndElements
             "1 1 1 1\n3 1 4 1\n1 1 2 4 5",
         );
         let body = parse_str(&text).unwrap().body(None).unwrap();
-        assert_eq!(body.mesh.tets.len(), 1);
+        assert_eq!(body.mesh.tets().len(), 1);
         assert_eq!(body.mesh.num_nodes(), 4);
         assert!(quality::inverted_cells(&body.mesh).is_empty());
     }

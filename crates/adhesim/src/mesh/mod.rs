@@ -1,4 +1,8 @@
-//! Meshes: nodes, cells, named node and face sets. No physics here.
+//! Meshes: nodes, cell blocks, named node and face sets. No physics here.
+//!
+//! The cells are kept in blocks, one per element type of [`crate::element::ELEMENT_TYPES`]
+//! in the table's order (hex8, then tet4), each a flat connectivity list. A cell's index in
+//! the mesh counts through the blocks in that order.
 //!
 //! Conventions
 //! - Hex8 cells use the VTK node order: nodes 0-3 are the face ζ = −1 counter-clockwise seen
@@ -10,6 +14,8 @@
 //!   right-hand-rule normal points out of the body.
 
 use std::collections::BTreeMap;
+
+use crate::element::{ElementType, HEX8, TET4};
 
 pub mod generate;
 pub mod gmsh;
@@ -25,6 +31,15 @@ pub enum Face {
 }
 
 impl Face {
+    /// The face of `cell` (global node indices) with local nodes `local` (three or four).
+    pub fn of_cell(cell: &[usize], local: &[usize]) -> Face {
+        match *local {
+            [a, b, c] => Face::Tri([cell[a], cell[b], cell[c]]),
+            [a, b, c, d] => Face::Quad([cell[a], cell[b], cell[c], cell[d]]),
+            _ => panic!("a cell face has three or four nodes, not {}", local.len()),
+        }
+    }
+
     /// The face's node indices.
     pub fn nodes(&self) -> &[usize] {
         match self {
@@ -34,19 +49,160 @@ impl Face {
     }
 }
 
+/// Cells of one element type: `element.nodes` node indices per cell, cell after cell.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CellBlock {
+    /// The element type of every cell of the block.
+    pub element: &'static ElementType,
+    /// Node indices (into the mesh's nodes), cell after cell.
+    pub connectivity: Vec<usize>,
+}
+
+impl CellBlock {
+    /// Number of cells.
+    pub fn len(&self) -> usize {
+        self.connectivity.len() / self.element.nodes
+    }
+
+    /// True when the block holds no cell.
+    pub fn is_empty(&self) -> bool {
+        self.connectivity.is_empty()
+    }
+
+    /// The node indices of each cell.
+    pub fn cells(&self) -> std::slice::ChunksExact<'_, usize> {
+        self.connectivity.chunks_exact(self.element.nodes)
+    }
+
+    /// The node indices of cell `c` of the block.
+    pub fn cell(&self, c: usize) -> &[usize] {
+        let n = self.element.nodes;
+        &self.connectivity[n * c..n * (c + 1)]
+    }
+
+    /// The cells as fixed-size arrays; `N` must be the type's node count.
+    pub fn as_arrays<const N: usize>(&self) -> &[[usize; N]] {
+        assert_eq!(
+            N, self.element.nodes,
+            "{} cells have {} nodes",
+            self.element.name, self.element.nodes
+        );
+        self.connectivity.as_chunks::<N>().0
+    }
+
+    /// The cells as mutable fixed-size arrays; `N` must be the type's node count.
+    pub fn as_arrays_mut<const N: usize>(&mut self) -> &mut [[usize; N]] {
+        assert_eq!(
+            N, self.element.nodes,
+            "{} cells have {} nodes",
+            self.element.name, self.element.nodes
+        );
+        self.connectivity.as_chunks_mut::<N>().0
+    }
+}
+
 /// An unstructured mesh of one body.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
     /// Reference coordinates of the nodes [m].
     pub nodes: Vec<[f64; 3]>,
-    /// Hexahedral cells (VTK order), indices into `nodes`.
-    pub hexes: Vec<[usize; 8]>,
-    /// Tetrahedral cells (VTK order), indices into `nodes`.
-    pub tets: Vec<[usize; 4]>,
+    /// The cells, one block per element type in the order of
+    /// [`crate::element::ELEMENT_TYPES`] (no empty blocks); node indices into `nodes`.
+    pub blocks: Vec<CellBlock>,
     /// Named node sets (sorted, no duplicates).
     pub node_sets: BTreeMap<String, Vec<usize>>,
     /// Named boundary face sets, outward oriented.
     pub face_sets: BTreeMap<String, Vec<Face>>,
+}
+
+impl Mesh {
+    /// The block of `element` cells, if the mesh has any.
+    pub fn block(&self, element: &ElementType) -> Option<&CellBlock> {
+        self.blocks.iter().find(|b| b.element == element)
+    }
+
+    /// The connectivity of the `element` block, created (in table order) when missing, for
+    /// adding cells: `element.nodes` indices per cell.
+    pub fn connectivity_mut(&mut self, element: &'static ElementType) -> &mut Vec<usize> {
+        let i = match self.blocks.iter().position(|b| b.element == element) {
+            Some(i) => i,
+            None => {
+                let at = self
+                    .blocks
+                    .iter()
+                    .position(|b| b.element.index() > element.index())
+                    .unwrap_or(self.blocks.len());
+                self.blocks.insert(
+                    at,
+                    CellBlock {
+                        element,
+                        connectivity: Vec::new(),
+                    },
+                );
+                at
+            }
+        };
+        &mut self.blocks[i].connectivity
+    }
+
+    /// Adds cells of type `element` (each `element.nodes` node indices).
+    pub fn add_cells<const N: usize>(
+        &mut self,
+        element: &'static ElementType,
+        cells: impl IntoIterator<Item = [usize; N]>,
+    ) {
+        assert_eq!(
+            N, element.nodes,
+            "{} cells have {} nodes",
+            element.name, element.nodes
+        );
+        let mut cells = cells.into_iter().peekable();
+        if cells.peek().is_some() {
+            self.connectivity_mut(element).extend(cells.flatten());
+        }
+    }
+
+    /// The cells of type `element` as fixed-size arrays (empty if there are none); `N` must
+    /// be the type's node count.
+    pub fn cells_of<const N: usize>(&self, element: &ElementType) -> &[[usize; N]] {
+        self.block(element).map_or(&[], |b| b.as_arrays())
+    }
+
+    /// The hex8 cells.
+    pub fn hexes(&self) -> &[[usize; 8]] {
+        self.cells_of(&HEX8)
+    }
+
+    /// The tet4 cells.
+    pub fn tets(&self) -> &[[usize; 4]] {
+        self.cells_of(&TET4)
+    }
+
+    /// The hex8 cells, mutable.
+    pub fn hexes_mut(&mut self) -> &mut [[usize; 8]] {
+        match self.blocks.iter_mut().find(|b| *b.element == HEX8) {
+            Some(b) => b.as_arrays_mut(),
+            None => &mut [],
+        }
+    }
+
+    /// Every cell in mesh order (block after block): its element type and node indices.
+    pub fn cells(&self) -> impl Iterator<Item = (&'static ElementType, &[usize])> + '_ {
+        self.blocks
+            .iter()
+            .flat_map(|b| b.cells().map(move |c| (b.element, c)))
+    }
+
+    /// Cell `c` in mesh order: its element type and node indices.
+    pub fn cell(&self, mut c: usize) -> (&'static ElementType, &[usize]) {
+        for b in &self.blocks {
+            if c < b.len() {
+                return (b.element, b.cell(c));
+            }
+            c -= b.len();
+        }
+        panic!("cell index beyond the mesh's {} cells", self.num_cells())
+    }
 }
 
 impl Mesh {
@@ -55,9 +211,9 @@ impl Mesh {
         self.nodes.len()
     }
 
-    /// Number of cells (hexes and tets).
+    /// Number of cells (all blocks).
     pub fn num_cells(&self) -> usize {
-        self.hexes.len() + self.tets.len()
+        self.blocks.iter().map(CellBlock::len).sum()
     }
 
     /// Adds (or replaces) a node set; the indices are sorted and de-duplicated.
@@ -97,14 +253,9 @@ impl Mesh {
             key.sort_unstable();
             count.entry(key).and_modify(|e| e.0 += 1).or_insert((1, f));
         };
-        for h in &self.hexes {
-            for f in HEX_FACES {
-                add(Face::Quad([h[f[0]], h[f[1]], h[f[2]], h[f[3]]]));
-            }
-        }
-        for t in &self.tets {
-            for f in TET_FACES {
-                add(Face::Tri([t[f[0]], t[f[1]], t[f[2]]]));
+        for (element, cell) in self.cells() {
+            for f in element.faces {
+                add(Face::of_cell(cell, f));
             }
         }
         count
@@ -137,10 +288,10 @@ impl Mesh {
     pub fn split_hexes_into_tets(&self) -> Mesh {
         let mut out = Mesh {
             nodes: self.nodes.clone(),
-            tets: self.tets.clone(),
             node_sets: self.node_sets.clone(),
             ..Default::default()
         };
+        out.add_cells(&TET4, self.tets().iter().copied());
         let perms = [
             [0, 1, 2],
             [0, 2, 1],
@@ -149,7 +300,8 @@ impl Mesh {
             [2, 0, 1],
             [2, 1, 0],
         ];
-        for h in &self.hexes {
+        let mut split = Vec::new();
+        for h in self.hexes() {
             for p in perms {
                 let c1 = 1 << p[0];
                 let c2 = c1 | (1 << p[1]);
@@ -162,9 +314,10 @@ impl Mesh {
                 if vol < 0.0 {
                     t.swap(1, 2);
                 }
-                out.tets.push(t);
+                split.push(t);
             }
         }
+        out.add_cells(&TET4, split);
         let boundary: std::collections::HashMap<Vec<usize>, Face> = out
             .cell_faces()
             .into_iter()
@@ -193,16 +346,3 @@ impl Mesh {
         out
     }
 }
-
-/// Local node indices of the six faces of a hex8 (VTK order), outward oriented.
-pub const HEX_FACES: [[usize; 4]; 6] = [
-    [0, 3, 2, 1], // ζ = −1
-    [4, 5, 6, 7], // ζ = +1
-    [0, 1, 5, 4], // η = −1
-    [2, 3, 7, 6], // η = +1
-    [0, 4, 7, 3], // ξ = −1
-    [1, 2, 6, 5], // ξ = +1
-];
-
-/// Local node indices of the four faces of a tet4 (VTK order), outward oriented.
-pub const TET_FACES: [[usize; 3]; 4] = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];

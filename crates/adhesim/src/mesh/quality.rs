@@ -1,64 +1,47 @@
 //! Mesh quality checks: scaled Jacobians, inverted cells, face-set orientation.
 //!
-//! Cells are indexed hexes first, then tets: cell `i < hexes.len()` is `hexes[i]`, cell
-//! `hexes.len() + j` is `tets[j]`.
+//! Cells are indexed in mesh order (block after block: hexes first, then tets). What is
+//! measured for each element type comes from its row of the element-type table
+//! ([`crate::element::ElementType::corner_frames`] and
+//! [`crate::element::ElementType::inverted_inside`]).
 
-use super::{Face, Mesh, HEX_FACES, TET_FACES};
-use crate::{Mat3, Vec3};
+use super::{Face, Mesh};
+use crate::Vec3;
 use std::collections::HashMap;
 
-/// For each hex corner (VTK order): the corner and its neighbours along ξ, η, ζ, ordered so
-/// that the three edge vectors form a right-handed frame in a valid hex.
-const HEX_CORNER_FRAMES: [[usize; 4]; 8] = [
-    [0, 1, 3, 4],
-    [1, 2, 0, 5],
-    [2, 3, 1, 6],
-    [3, 0, 2, 7],
-    [4, 7, 5, 0],
-    [5, 4, 6, 1],
-    [6, 5, 7, 2],
-    [7, 6, 4, 3],
-];
-
-/// Natural coordinates (ξ, η, ζ) of the hex8 nodes (VTK order).
-use crate::element::HEX_NODE_XI as HEX_NATURAL;
-
-/// Minimum scaled Jacobian of every cell (hexes first, then tets), dimensionless.
+/// Minimum scaled Jacobian of every cell (mesh order), dimensionless.
 ///
-/// Hex: the minimum over the 8 corners of det[e₁, e₂, e₃] of the unit edge vectors leaving
-/// the corner along ξ, η, ζ (right-handed in a valid hex). Tet: det of the unit edge vectors
-/// x₁ − x₀, x₂ − x₀, x₃ − x₀ at node 0. The value is 1 for a cube (and for a tet with a
-/// right-angled corner at node 0, 1/√2 for a regular tet), ≤ 0 for an inverted or degenerate
-/// cell (a zero-length edge gives 0).
+/// The minimum over the corners of the type's corner frames of det[e₁, e₂, e₃], the unit edge
+/// vectors leaving the corner along the natural axes (right-handed in a valid cell). Hex:
+/// the 8 corners; tet: node 0 with the edges x₁ − x₀, x₂ − x₀, x₃ − x₀. The value is 1 for a
+/// cube (and for a tet with a right-angled corner at node 0, 1/√2 for a regular tet), ≤ 0
+/// for an inverted or degenerate cell (a zero-length edge gives 0).
 pub fn cell_min_jacobian_ratio(mesh: &Mesh) -> Vec<f64> {
-    let hexes = mesh.hexes.iter().map(|h| {
-        HEX_CORNER_FRAMES
-            .iter()
-            .map(|f| corner_ratio(&mesh.nodes, h[f[0]], [h[f[1]], h[f[2]], h[f[3]]]))
-            .fold(f64::INFINITY, f64::min)
-    });
-    let tets = mesh
-        .tets
-        .iter()
-        .map(|t| corner_ratio(&mesh.nodes, t[0], [t[1], t[2], t[3]]));
-    hexes.chain(tets).collect()
+    mesh.cells()
+        .map(|(element, c)| {
+            element
+                .corner_frames
+                .iter()
+                .map(|f| corner_ratio(&mesh.nodes, c[f[0]], [c[f[1]], c[f[2]], c[f[3]]]))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .collect()
 }
 
-/// Indices of the inverted or degenerate cells (hexes first, then tets): cells whose scaled
-/// Jacobian ratio is ≤ 0 or, for hexes, whose Jacobian determinant is ≤ 0 at one of the
-/// 2 × 2 × 2 Gauss points (±1/√3).
+/// Indices of the inverted or degenerate cells (mesh order): cells whose scaled Jacobian
+/// ratio is ≤ 0 or that the type's own test finds inverted inside (hexes: a Jacobian
+/// determinant ≤ 0 at one of the 2 × 2 × 2 Gauss points, ±1/√3).
 pub fn inverted_cells(mesh: &Mesh) -> Vec<usize> {
     let ratios = cell_min_jacobian_ratio(mesh);
-    let nh = mesh.hexes.len();
-    (0..ratios.len())
-        .filter(|&c| {
-            ratios[c] <= 0.0
-                || ratios[c].is_nan()
-                || (c < nh
-                    && hex_gauss_dets(&hex_coords(mesh, c))
-                        .iter()
-                        .any(|&d| d <= 0.0))
+    mesh.cells()
+        .enumerate()
+        .filter(|&(c, (element, cell))| {
+            ratios[c] <= 0.0 || ratios[c].is_nan() || {
+                let x: Vec<[f64; 3]> = cell.iter().map(|&i| mesh.nodes[i]).collect();
+                (element.inverted_inside)(&x)
+            }
         })
+        .map(|(c, _)| c)
         .collect()
 }
 
@@ -93,36 +76,12 @@ fn corner_ratio(nodes: &[[f64; 3]], corner: usize, ends: [usize; 3]) -> f64 {
     e[0].dot(&e[1].cross(&e[2]))
 }
 
-fn hex_coords(mesh: &Mesh, cell: usize) -> [[f64; 3]; 8] {
-    mesh.hexes[cell].map(|i| mesh.nodes[i])
-}
-
-/// Jacobian matrix ∂x/∂(ξ, η, ζ) (rows x, y, z) of a trilinear hex at natural point `xi`.
-fn hex_jacobian(x: &[[f64; 3]; 8], xi: [f64; 3]) -> Mat3 {
-    let mut j = Mat3::zeros();
-    for (a, n) in HEX_NATURAL.iter().enumerate() {
-        let f = [1.0 + n[0] * xi[0], 1.0 + n[1] * xi[1], 1.0 + n[2] * xi[2]];
-        let grad = Vec3::new(
-            0.125 * n[0] * f[1] * f[2],
-            0.125 * n[1] * f[0] * f[2],
-            0.125 * n[2] * f[0] * f[1],
-        );
-        j += Vec3::from(x[a]) * grad.transpose();
-    }
-    j
-}
-
-/// Jacobian determinants of a hex at the 2 × 2 × 2 Gauss points (±1/√3) [m³ per unit
-/// natural volume]; each Gauss weight is 1.
-fn hex_gauss_dets(x: &[[f64; 3]; 8]) -> [f64; 8] {
-    let g = 1.0 / 3f64.sqrt();
-    HEX_NATURAL.map(|n| hex_jacobian(x, n.map(|s| s * g)).determinant())
-}
-
 /// Volume of hex `cell` by 2 × 2 × 2 Gauss quadrature [m³].
 #[cfg(test)]
 pub(crate) fn hex_volume(mesh: &Mesh, cell: usize) -> f64 {
-    hex_gauss_dets(&hex_coords(mesh, cell)).iter().sum()
+    crate::element::hex8::hex8_gauss_dets(&mesh.hexes()[cell].map(|i| mesh.nodes[i]))
+        .iter()
+        .sum()
 }
 
 /// Every cell face keyed by its sorted node list: the owning cells and their outward faces.
@@ -133,15 +92,9 @@ fn face_owners(mesh: &Mesh) -> HashMap<Vec<usize>, Vec<(usize, Face)>> {
         key.sort_unstable();
         owners.entry(key).or_default().push((cell, face));
     };
-    for (c, h) in mesh.hexes.iter().enumerate() {
-        for f in HEX_FACES {
-            add(c, Face::Quad(f.map(|k| h[k])));
-        }
-    }
-    let nh = mesh.hexes.len();
-    for (c, t) in mesh.tets.iter().enumerate() {
-        for f in TET_FACES {
-            add(nh + c, Face::Tri(f.map(|k| t[k])));
+    for (c, (element, cell)) in mesh.cells().enumerate() {
+        for f in element.faces {
+            add(c, Face::of_cell(cell, f));
         }
     }
     owners
@@ -209,17 +162,13 @@ fn centroid(nodes: &[[f64; 3]], ids: &[usize]) -> Vec3 {
 }
 
 fn cell_centroid(mesh: &Mesh, cell: usize) -> Vec3 {
-    let nh = mesh.hexes.len();
-    if cell < nh {
-        centroid(&mesh.nodes, &mesh.hexes[cell])
-    } else {
-        centroid(&mesh.nodes, &mesh.tets[cell - nh])
-    }
+    centroid(&mesh.nodes, mesh.cell(cell).1)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::element::{HEX8, TET4};
 
     const CUBE: [[f64; 3]; 8] = [
         [0.0, 0.0, 0.0],
@@ -233,19 +182,17 @@ mod tests {
     ];
 
     fn one_hex(nodes: [[f64; 3]; 8]) -> Mesh {
-        Mesh {
+        let mut m = Mesh {
             nodes: nodes.to_vec(),
-            hexes: vec![[0, 1, 2, 3, 4, 5, 6, 7]],
             ..Mesh::default()
-        }
+        };
+        m.add_cells(&HEX8, [[0, 1, 2, 3, 4, 5, 6, 7]]);
+        m
     }
 
     fn all_faces(mesh: &Mesh) -> Vec<Face> {
-        let h = mesh.hexes[0];
-        HEX_FACES
-            .iter()
-            .map(|f| Face::Quad(f.map(|k| h[k])))
-            .collect()
+        let h = mesh.hexes()[0];
+        HEX8.faces.iter().map(|f| Face::of_cell(&h, f)).collect()
     }
 
     #[test]
@@ -276,11 +223,11 @@ mod tests {
     #[test]
     fn detects_swapped_nodes() {
         let mut m = one_hex(CUBE);
-        m.hexes[0].swap(1, 3);
+        m.hexes_mut()[0].swap(1, 3);
         assert!(cell_min_jacobian_ratio(&m)[0] < 0.0);
         assert_eq!(inverted_cells(&m), vec![0]);
         let mut m = one_hex(CUBE);
-        m.hexes[0].swap(2, 6);
+        m.hexes_mut()[0].swap(2, 6);
         assert_eq!(inverted_cells(&m), vec![0]);
     }
 
@@ -315,8 +262,13 @@ mod tests {
             [3.0, 1.0, 0.0],
             [3.0, 0.0, 1.0],
         ]);
-        m.tets.push([base, base + 1, base + 2, base + 3]);
-        m.tets.push([base, base + 2, base + 1, base + 3]);
+        m.add_cells(
+            &TET4,
+            [
+                [base, base + 1, base + 2, base + 3],
+                [base, base + 2, base + 1, base + 3],
+            ],
+        );
         let r = cell_min_jacobian_ratio(&m);
         assert_eq!(r.len(), 3);
         assert!((r[1] - 1.0).abs() < 1e-14);
@@ -354,9 +306,12 @@ mod tests {
         nodes.extend(CUBE[4..].iter().map(|p| [p[0], p[1], 2.0]));
         let mut m = Mesh {
             nodes,
-            hexes: vec![[0, 1, 2, 3, 4, 5, 6, 7], [4, 5, 6, 7, 8, 9, 10, 11]],
             ..Mesh::default()
         };
+        m.add_cells(
+            &HEX8,
+            [[0, 1, 2, 3, 4, 5, 6, 7], [4, 5, 6, 7, 8, 9, 10, 11]],
+        );
         m.set_faces("middle", vec![Face::Quad([4, 5, 6, 7])]);
         let err = check_faces_outward(&m).unwrap_err();
         assert!(

@@ -11,7 +11,7 @@ pub mod vtk;
 use crate::assembly::Discretisation;
 use crate::contact::history::{FieldKind, HistoryField, Slot};
 use crate::contact::{Interface, Master, RigidShape};
-use crate::element::{element_cauchy_stress, von_mises};
+use crate::element::von_mises;
 use crate::problem::{Dirichlet, Problem};
 use crate::time::{NodeContact, State, StepReport};
 use std::io;
@@ -144,8 +144,8 @@ fn frame_file_index(rest: &str) -> Option<usize> {
 /// Per-body arrays of one frame.
 struct BodyFrame {
     points: Vec<[f64; 3]>,
-    hex_conn: Vec<usize>,
-    tet_conn: Vec<usize>,
+    /// The body's cell blocks: element type and connectivity.
+    blocks: Vec<crate::mesh::CellBlock>,
     u: Vec<[f64; 3]>,
     v: Vec<[f64; 3]>,
     cauchy: Vec<[f64; 9]>,
@@ -175,8 +175,7 @@ fn body_frames(view: &StepView) -> Vec<BodyFrame> {
             .collect();
         let mut f = BodyFrame {
             points,
-            hex_conn: body.mesh.hexes.iter().flatten().copied().collect(),
-            tet_conn: body.mesh.tets.iter().flatten().copied().collect(),
+            blocks: body.mesh.blocks.clone(),
             u: uu,
             v: vv,
             cauchy: Vec::new(),
@@ -185,27 +184,17 @@ fn body_frames(view: &StepView) -> Vec<BodyFrame> {
             node_id: (0..nn).map(|i| id_i32(off + i)).collect(),
             body_id: vec![id_i32(bi); body.mesh.num_cells()],
         };
-        let mat = &*disc.materials[bi];
         let mut push = |s: crate::Mat3, j: f64| {
             f.cauchy.push(std::array::from_fn(|k| s[(k / 3, k % 3)]));
             f.mises.push(von_mises(&s));
             f.jac.push(j);
         };
-        for e in 0..disc.hexes.len() {
-            if disc.hexes.body[e] == bi {
-                let ue = disc.hexes.nodes[e].map(|n| [u[3 * n], u[3 * n + 1], u[3 * n + 2]]);
-                let (s, j) = if disc.hexes.fbar[e] {
-                    crate::fbar::fbar_cauchy_stress(&disc.hexes.gauss[e], &ue, mat)
-                } else {
-                    element_cauchy_stress(&disc.hexes.gauss[e], &ue, mat)
-                };
-                push(s, j);
-            }
-        }
-        for e in 0..disc.tets.len() {
-            if disc.tets.body[e] == bi {
-                let (s, j) = disc.tet_cauchy_stress(e, u, patches.as_ref());
-                push(s, j);
+        for (k, block) in disc.blocks.iter().enumerate() {
+            for e in 0..block.len() {
+                if block.body(e) == bi {
+                    let (s, j) = disc.cell_cauchy_stress(k, e, u, patches.as_ref());
+                    push(s, j);
+                }
             }
         }
         out.push(f);
@@ -231,11 +220,8 @@ impl Observer for FrameWriter {
         let mut bodies = Vec::new();
         for (i, f) in body_frames(view).iter().enumerate() {
             let mut p = vtk::Piece::new(&f.points);
-            if !f.hex_conn.is_empty() {
-                p = p.with_cells(vtk::CellKind::Hex8, &f.hex_conn);
-            }
-            if !f.tet_conn.is_empty() {
-                p = p.with_cells(vtk::CellKind::Tet4, &f.tet_conn);
+            for b in f.blocks.iter().filter(|b| !b.is_empty()) {
+                p = p.with_cells(vtk::CellKind::Element(b.element), &b.connectivity);
             }
             let p = p
                 .with_point_data("u", vtk::FieldData::Vector(&f.u))

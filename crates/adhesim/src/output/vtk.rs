@@ -41,24 +41,22 @@ use super::atomic::{write_atomic, write_atomic_with};
 /// Kind of a cell, with VTK's linear node ordering.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum CellKind {
-    /// 8-node hexahedron (`VTK_HEXAHEDRON`, 12).
-    Hex8,
-    /// 4-node tetrahedron (`VTK_TETRA`, 10).
-    Tet4,
     /// 4-node quadrilateral (`VTK_QUAD`, 9).
     Quad4,
     /// 3-node triangle (`VTK_TRIANGLE`, 5).
     Tri3,
     /// Single point (`VTK_VERTEX`, 1).
     Vertex,
+    /// A volume element type of the element-type table ([`crate::element::ELEMENT_TYPES`]:
+    /// hex8 is `VTK_HEXAHEDRON`, 12, tet4 `VTK_TETRA`, 10), with its VTK type and node count.
+    Element(&'static crate::element::ElementType),
 }
 
 impl CellKind {
     /// The VTK cell type number.
     pub const fn vtk_type(self) -> u8 {
         match self {
-            CellKind::Hex8 => 12,
-            CellKind::Tet4 => 10,
+            CellKind::Element(e) => e.vtk_type,
             CellKind::Quad4 => 9,
             CellKind::Tri3 => 5,
             CellKind::Vertex => 1,
@@ -68,8 +66,8 @@ impl CellKind {
     /// Number of nodes of one cell of this kind.
     pub const fn num_nodes(self) -> usize {
         match self {
-            CellKind::Hex8 => 8,
-            CellKind::Tet4 | CellKind::Quad4 => 4,
+            CellKind::Element(e) => e.nodes,
+            CellKind::Quad4 => 4,
             CellKind::Tri3 => 3,
             CellKind::Vertex => 1,
         }
@@ -670,6 +668,7 @@ fn push_time(out: &mut String, t: f64) {
 mod tests {
     use super::super::atomic::test_support::TestDir;
     use super::*;
+    use crate::element::{HEX8, TET4};
     use base64::Engine as _;
 
     /// A parsed XML element (test-only, strict subset of XML: no comments, CDATA or DTD).
@@ -915,7 +914,7 @@ mod tests {
     fn pieces(f: &Fixture) -> Vec<Piece<'_>> {
         vec![
             Piece::new(&f.hex_points)
-                .with_cells(CellKind::Hex8, &f.hex_conn)
+                .with_cells(CellKind::Element(&HEX8), &f.hex_conn)
                 .with_point_data("temperature", FieldData::Scalar(&f.temperature))
                 .with_point_data("u", FieldData::Vector(&f.displacement))
                 .with_cell_data("stress", FieldData::Tensor(&f.stress))
@@ -1021,7 +1020,7 @@ mod tests {
             .collect();
         let ids: Vec<i32> = (0..n_cells as i32).collect();
         let piece = Piece::new(&points)
-            .with_cells(CellKind::Tet4, &conn)
+            .with_cells(CellKind::Element(&TET4), &conn)
             .with_cell_data("id", FieldData::Int(&ids));
         write_vtu(&path, &[piece]).unwrap();
         let root = parse_xml(&std::fs::read_to_string(&path).unwrap());
@@ -1049,7 +1048,7 @@ mod tests {
         let cases: Vec<(Vec<Piece>, &str)> = vec![
             (vec![], "at least one piece"),
             (
-                vec![Piece::new(&f.hex_points).with_cells(CellKind::Hex8, &bad_conn)],
+                vec![Piece::new(&f.hex_points).with_cells(CellKind::Element(&HEX8), &bad_conn)],
                 "point 99",
             ),
             (
@@ -1062,7 +1061,7 @@ mod tests {
             ),
             (
                 vec![Piece::new(&f.hex_points)
-                    .with_cells(CellKind::Hex8, &f.hex_conn)
+                    .with_cells(CellKind::Element(&HEX8), &f.hex_conn)
                     .with_cell_data("t", FieldData::Scalar(&short))],
                 "has 3 entries, expected 2",
             ),
@@ -1080,7 +1079,7 @@ mod tests {
             (
                 vec![
                     Piece::new(&f.hex_points)
-                        .with_cells(CellKind::Hex8, &f.hex_conn)
+                        .with_cells(CellKind::Element(&HEX8), &f.hex_conn)
                         .with_cell_data("m", FieldData::Int(&f.material)),
                     Piece::new(&f.quad_points)
                         .with_cells(CellKind::Quad4, &f.quad_conn)
@@ -1259,7 +1258,7 @@ mod tests {
         let f = fixture();
         let (points, surface_conn, temperature, material) = single_piece_arrays(&f);
         let piece = Piece::new(&points)
-            .with_cells(CellKind::Hex8, &f.hex_conn)
+            .with_cells(CellKind::Element(&HEX8), &f.hex_conn)
             .with_cells(CellKind::Quad4, &surface_conn[..4])
             .with_cells(CellKind::Vertex, &surface_conn[4..])
             .with_point_data("temperature", FieldData::Scalar(&temperature))
