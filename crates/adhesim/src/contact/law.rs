@@ -186,11 +186,11 @@ pub trait Interface {
     /// Gauss-Seidel point solver ([`solve_point`]) solves with it.
     fn adhesion_at(&self, start: &BondState, dt: f64, area: f64, x: [f64; 3]) -> AdhEval;
 
-    /// Warm start of the point solver's adhesive sub-problem: stiffnesses per unit area
-    /// [N/m³] along t₁, t₂ and n of linear springs that, times A β₀², approximate the bond at
-    /// its frozen history (the normal one acting in tension only). Only called when
+    /// Warm start of the point solver's adhesive sub-problem at a point whose history is frozen
+    /// at `start`, with tributary area `area` [m²]: the linear springs that approximate its
+    /// bond, or None when it has none to start from. Only called when
     /// [`Interface::is_adhesive`].
-    fn frozen_springs(&self) -> [f64; 3];
+    fn frozen_springs(&self, start: &BondState, area: f64) -> Option<FrozenSprings>;
 
     /// Warnings of the law about a contact pair's parameters (e.g. an adhesive stiffness the
     /// mesh cannot resolve), appended to `out`; none by default.
@@ -219,6 +219,17 @@ pub trait Interface {
 
     /// The history of a node that is no longer a contact candidate, from its last one.
     fn release(&self, node: &NodeHistory) -> NodeHistory;
+}
+
+/// Linear springs r̃ ≈ −K (x + e) approximating a point's bond at its frozen history, the warm
+/// start of the Gauss-Seidel point solver's adhesive sub-problem
+/// ([`Interface::frozen_springs`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrozenSprings {
+    /// Diagonal of K along t₁, t₂ and n [N/m]; the normal spring acts in tension only.
+    pub stiffness: [f64; 3],
+    /// Stretch e of the tangential springs at x = 0, along t₁ and t₂ [m].
+    pub stretch: [f64; 2],
 }
 
 /// What a law's own checks of a contact pair see ([`Interface::warnings`]).
@@ -1083,21 +1094,18 @@ fn frozen_adhesion_guess(ctx: &Ctx, y: V3) -> V3 {
     if !p.law.is_adhesive() {
         return [0.0; 3];
     }
-    let c = p.law.frozen_springs();
-    let b0 = clamp01(p.bond0.beta);
-    let k = p.area * b0 * b0;
-    if k.is_nan() || k <= 0.0 {
+    let Some(FrozenSprings {
+        stiffness: c,
+        stretch: e,
+    }) = p.law.frozen_springs(&p.bond0, p.area)
+    else {
         return [0.0; 3];
-    }
+    };
     // In scaled variables the springs are T⁻¹KT⁻¹ and the stretch T e.
-    let kd = [
-        k * c[0],
-        k * c[1] / (s * s),
-        if y[2] > 0.0 { k * c[2] } else { 0.0 },
-    ];
+    let kd = [c[0], c[1] / (s * s), if y[2] > 0.0 { c[2] } else { 0.0 }];
     let rhs = [
-        -kd[0] * (y[0] + p.bond0.ut[0]),
-        -kd[1] * (y[1] + s * p.bond0.ut[1]),
+        -kd[0] * (y[0] + e[0]),
+        -kd[1] * (y[1] + s * e[1]),
         -kd[2] * y[2],
     ];
     let mut m = identity();
@@ -1272,7 +1280,7 @@ pub fn projection_jacobian(r_star: V3, mu: f64, case: ContactState) -> M3 {
 // ---------------------------------------------------------------------------------------------
 // Small dense helpers on [f64; 3] and [[f64; 3]; 3].
 
-fn clamp01(v: f64) -> f64 {
+pub(super) fn clamp01(v: f64) -> f64 {
     if v > 1.0 {
         1.0
     } else if v > 0.0 {

@@ -10,8 +10,8 @@
 
 use super::history::{FieldKind, HistoryField, LawHistory, NodeHistory, Slot};
 use super::law::{
-    accumulated_damage, adhesive_response, rcc_adhesion_at, AdhEval, AdhesiveResponse, BondState,
-    Interface, InterfaceLaw, PairScales, PointSolution,
+    accumulated_damage, adhesive_response, clamp01, rcc_adhesion_at, AdhEval, AdhesiveResponse,
+    BondState, FrozenSprings, Interface, InterfaceLaw, PairScales, PointSolution,
 };
 use crate::warnings::{cohesive_zone_length, CN_STIFFNESS_RATIO};
 
@@ -123,11 +123,18 @@ impl Interface for InterfaceLaw {
         }
     }
 
-    fn frozen_springs(&self) -> [f64; 3] {
-        match &self.adhesion {
-            Some(a) => [a.ct, a.ct2, a.cn],
-            None => [0.0; 3],
+    /// Springs A β₀² (C_t, C_t2, C_n) at the undegraded stiffnesses, stretched by u_t0.
+    fn frozen_springs(&self, start: &BondState, area: f64) -> Option<FrozenSprings> {
+        let a = self.adhesion.as_ref()?;
+        let b0 = clamp01(start.beta);
+        let k = area * b0 * b0;
+        if k.is_nan() || k <= 0.0 {
+            return None;
         }
+        Some(FrozenSprings {
+            stiffness: [k * a.ct, k * a.ct2, k * a.cn],
+            stretch: start.ut,
+        })
     }
 
     fn adhesive_response(
