@@ -13,6 +13,7 @@
 //!   fewer than [`MIN_ELEMENTS_ACROSS_CONTACT`] slave elements, measured where the contact
 //!   starts (the local element size, not the mean over the surface).
 
+use crate::contact::law::{Interface, PairScales};
 use crate::contact::{Master, RigidShape};
 use crate::mesh::Mesh;
 use crate::problem::{Problem, Table};
@@ -181,40 +182,27 @@ fn contact_warnings(problem: &Problem, out: &mut Vec<String>) {
         if !(h > 0.0 && h.is_finite()) {
             continue;
         }
-        // Stiff adhesive links.
-        if let Some(a) = &pair.law.adhesion {
-            let areas: Vec<f64> = pair
-                .slave_area
-                .iter()
-                .copied()
-                .filter(|a| *a > 0.0)
-                .collect();
-            if !areas.is_empty() {
-                let area = areas.iter().sum::<f64>() / areas.len() as f64;
-                let g = body.material.shear_modulus();
-                let k = body.material.bulk_modulus();
-                let e = 9.0 * k * g / (3.0 * k + g);
-                let nu = (3.0 * k - 2.0 * g) / (2.0 * (3.0 * k + g));
-                let zone = cohesive_zone_length(e, nu, a.cn);
-                if zone < h {
-                    out.push(format!(
-                        "contact {:?}: the cohesive zone E*/C_n = {zone:.3e} m (E* = E/(1 − ν²) = {:.3e} Pa, C_n = {:.3e} N/m³) is shorter than the mean slave edge {h:.3e} m (warning below one edge): the peak adhesive traction falls between nodes and de-bonding jumps from node to node; refine the slave surface to a few elements per {zone:.3e} m or lower C_n",
-                        pair.name,
-                        e / (1.0 - nu * nu),
-                        a.cn
-                    ));
-                }
-                let link = a.cn * area;
-                let body_stiffness = e * h;
-                let ratio = link / body_stiffness;
-                if ratio > CN_STIFFNESS_RATIO {
-                    out.push(format!(
-                        "contact {:?}: the adhesive normal stiffness per slave node C_n·A = {link:.3e} N/m (C_n = {:.3e} N/m³, mean tributary area {area:.3e} m²) is {ratio:.3e} times (warning above {CN_STIFFNESS_RATIO:.0e}) the body's stiffness per node E·h = {body_stiffness:.3e} N/m (E = {e:.3e} Pa, mean slave edge {h:.3e} m): the contact solve will be ill-conditioned and may need many sweeps or Δt cut-backs; a smaller C_n gives nearly the same response",
-                        pair.name, a.cn
-                    ));
-                }
-            }
-        }
+        // The law's own checks (e.g. stiff adhesive links).
+        let areas: Vec<f64> = pair
+            .slave_area
+            .iter()
+            .copied()
+            .filter(|a| *a > 0.0)
+            .collect();
+        let g = body.material.shear_modulus();
+        let k = body.material.bulk_modulus();
+        let scales = PairScales {
+            name: &pair.name,
+            mean_area: if areas.is_empty() {
+                None
+            } else {
+                Some(areas.iter().sum::<f64>() / areas.len() as f64)
+            },
+            young: 9.0 * k * g / (3.0 * k + g),
+            poisson: (3.0 * k - 2.0 * g) / (2.0 * (3.0 * k + g)),
+            edge: h,
+        };
+        pair.law.warnings(&scales, out);
         // Contact zone resolution under a rigid sphere or cylinder.
         if let Master::Rigid { shape, motion } = &pair.master {
             let radius = match *shape {

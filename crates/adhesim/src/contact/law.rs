@@ -154,8 +154,11 @@ impl InterfaceLaw {
 /// take at the start of a step, the adhesive response at that history, the history to commit
 /// from a point's solution, and the force scale of its bonds.
 ///
-/// The Gauss-Seidel point solver ([`solve_point`]) evaluates the RCC adhesion of the law's
-/// parameters directly (implicitly in x, with its own warm start).
+/// Every point solver reaches the adhesive part only through this trait, statically: the
+/// Gauss-Seidel point solver ([`solve_point`], implicit in x) through
+/// [`Interface::is_adhesive`], [`Interface::adhesion_at`], [`Interface::frozen_springs`] and
+/// [`Interface::bond_traction`], the fclib Newton and the mixed solve through
+/// [`Interface::adhesive_response`].
 ///
 /// The RCC law, with dry Coulomb friction as its case without adhesion, implements it in
 /// `rcc.rs`; a law's history is registered in [`REGISTERED_HISTORIES`].
@@ -171,6 +174,27 @@ pub trait Interface {
     /// Largest quasi-static traction of the law's bonds [Pa] (0 without adhesion): times a
     /// point's area, the force its bond can carry.
     fn bond_traction(&self) -> f64;
+
+    /// Whether the law has an adhesive part; without one the point solvers skip the adhesive
+    /// sub-problem and r̃ = 0.
+    fn is_adhesive(&self) -> bool;
+
+    /// The adhesive law at the local relative displacement `x` [m] (unscaled axes) of a point
+    /// whose history is frozen at `start`, over a step of `dt` [s], with tributary area `area`
+    /// [m²]: the force r̃, its tangent −∂r̃/∂x, the incremental potential and the history
+    /// values the step leads to. Only called when [`Interface::is_adhesive`]; the
+    /// Gauss-Seidel point solver ([`solve_point`]) solves with it.
+    fn adhesion_at(&self, start: &BondState, dt: f64, area: f64, x: [f64; 3]) -> AdhEval;
+
+    /// Warm start of the point solver's adhesive sub-problem at a point whose history is frozen
+    /// at `start`, with tributary area `area` [m²]: the linear springs that approximate its
+    /// bond, or None when it has none to start from. Only called when
+    /// [`Interface::is_adhesive`].
+    fn frozen_springs(&self, start: &BondState, area: f64) -> Option<FrozenSprings>;
+
+    /// Warnings of the law about a contact pair's parameters (e.g. an adhesive stiffness the
+    /// mesh cannot resolve), appended to `out`; none by default.
+    fn warnings(&self, _pair: &PairScales, _out: &mut Vec<String>) {}
 
     /// The adhesive response at the local relative displacement `x` [m] of a point whose
     /// history is frozen at `start`, over a step of `dt` [s], with tributary area `area` [m²]
@@ -195,6 +219,32 @@ pub trait Interface {
 
     /// The history of a node that is no longer a contact candidate, from its last one.
     fn release(&self, node: &NodeHistory) -> NodeHistory;
+}
+
+/// Linear springs r̃ ≈ −K (x + e) approximating a point's bond at its frozen history, the warm
+/// start of the Gauss-Seidel point solver's adhesive sub-problem
+/// ([`Interface::frozen_springs`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrozenSprings {
+    /// Diagonal of K along t₁, t₂ and n [N/m]; the normal spring acts in tension only.
+    pub stiffness: [f64; 3],
+    /// Stretch e of the tangential springs at x = 0, along t₁ and t₂ [m].
+    pub stretch: [f64; 2],
+}
+
+/// What a law's own checks of a contact pair see ([`Interface::warnings`]).
+#[derive(Clone, Copy, Debug)]
+pub struct PairScales<'a> {
+    /// Name of the contact pair.
+    pub name: &'a str,
+    /// Mean tributary area of the slave nodes with a positive one [m²], None if there is none.
+    pub mean_area: Option<f64>,
+    /// Young's modulus E of the slave body at small strain [Pa].
+    pub young: f64,
+    /// Poisson's ratio ν of the slave body at small strain [-].
+    pub poisson: f64,
+    /// Mean slave edge h [m].
+    pub edge: f64,
 }
 
 /// The history fields of every registered interface law.
@@ -474,19 +524,19 @@ struct Eval {
     f: V3,
 }
 
-/// Adhesive law evaluated at one x.
+/// An adhesive law evaluated at one x ([`Interface::adhesion_at`]).
 #[derive(Clone, Copy, Debug, Default)]
-struct AdhEval {
+pub struct AdhEval {
     /// β₁ [-].
-    beta: f64,
+    pub beta: f64,
     /// Bond stretch u_t0 + x_t [m].
-    ut: [f64; 2],
+    pub ut: [f64; 2],
     /// Adhesive force r̃ [N].
-    force: V3,
+    pub force: V3,
     /// −∂r̃/∂x [N/m] (symmetric).
-    stiff: M3,
+    pub stiff: M3,
     /// Incremental interface potential φ(x) [J], with ∂φ/∂x = −r̃.
-    energy: f64,
+    pub energy: f64,
 }
 
 /// Per-solve constants.
@@ -559,9 +609,10 @@ fn solve_scaled(
     t2: f64,
 ) -> PointSolution {
     let mu = p.law.mu.max(0.0);
-    let adh_scale = match &p.law.adhesion {
-        Some(a) => p.area.abs() * a.peak_traction(),
-        None => 0.0,
+    let adh_scale = if p.law.is_adhesive() {
+        p.area.abs() * p.law.bond_traction()
+    } else {
+        0.0
     };
     let rho = if p.rho.is_finite() && p.rho > 0.0 {
         p.rho
@@ -641,9 +692,10 @@ fn solve_by_cases(ctx: &Ctx, r_start: V3, max_iter: usize) -> Result<PointSoluti
         return Ok(finish(&ev, ContactState::Apart, 1, true));
     }
     // Stick.
-    let r_adh0 = match &p.law.adhesion {
-        Some(a) => adhesion_eval(ctx, a, [0.0; 3]).force,
-        None => [0.0; 3],
+    let r_adh0 = if p.law.is_adhesive() {
+        adhesion_eval(ctx, [0.0; 3]).force
+    } else {
+        [0.0; 3]
     };
     let r_stick = stick_force(p.w_aa, p.x_free).map(|r| sub(r, r_adh0));
     if let Some(rs) = r_stick {
@@ -679,12 +731,11 @@ fn slide_residual(ctx: &Ctx, q: V3) -> (V3, M3, V3, V3) {
     let mu = ctx.mu;
     let x = [-lam * c[0], -lam * c[1], 0.0];
     let rd = [mu * rn * c[0], mu * rn * c[1], rn];
-    let (ra, k) = match &p.law.adhesion {
-        Some(a) => {
-            let ad = adhesion_eval(ctx, a, x);
-            (ad.force, ad.stiff)
-        }
-        None => ([0.0; 3], [[0.0; 3]; 3]),
+    let (ra, k) = if p.law.is_adhesive() {
+        let ad = adhesion_eval(ctx, x);
+        (ad.force, ad.stiff)
+    } else {
+        ([0.0; 3], [[0.0; 3]; 3])
     };
     let w = p.w_aa;
     let res = sub(add(p.x_free, matvec(w, add(rd, ra))), x);
@@ -871,9 +922,10 @@ fn bipotential_iteration(
 fn evaluate(ctx: &Ctx, r_dry: V3, z_start: V3) -> Eval {
     let p = ctx.p;
     let y = add(p.x_free, matvec(p.w_aa, r_dry));
-    let (x, r_adh, adh) = match &p.law.adhesion {
-        Some(a) => solve_adhesion(ctx, a, y, z_start),
-        None => (y, [0.0; 3], AdhEval::default()),
+    let (x, r_adh, adh) = if p.law.is_adhesive() {
+        solve_adhesion(ctx, y, z_start)
+    } else {
+        (y, [0.0; 3], AdhEval::default())
     };
     let r_star = bipotential_trial(r_dry, x, ctx.mu, ctx.rho);
     let (proj, case) = dry_projection(r_star, ctx.mu);
@@ -937,20 +989,27 @@ fn beta_step(beta0: f64, dt: f64, p: &RccParams, e: f64) -> (f64, f64) {
 /// The adhesive law at x: β₁, u_t, r̃, −∂r̃/∂x and the incremental potential
 /// φ = A [½ E β₁² − w β₁ + b/(2Δt) (β₁ − β₀)²] (β₁ minimises the bracket over [0, 1], so
 /// ∂φ/∂x = A β₁² ∂E/∂x / 2 = −r̃).
-fn adhesion_eval(ctx: &Ctx, a: &RccParams, x: V3) -> AdhEval {
+fn adhesion_eval(ctx: &Ctx, x: V3) -> AdhEval {
     let (p, s) = (ctx.p, ctx.t2);
     if s == 1.0 {
-        return adhesion_at(p.bond0, p.dt, p.area, a, x);
+        return p.law.adhesion_at(&p.bond0, p.dt, p.area, x);
     }
     // x is scaled (x' = T x): the law at T⁻¹x', its force as T⁻¹r̃ and stiffness T⁻¹KT⁻¹.
-    let mut ev = adhesion_at(p.bond0, p.dt, p.area, a, unscale(x, s));
+    let mut ev = p.law.adhesion_at(&p.bond0, p.dt, p.area, unscale(x, s));
     ev.force = unscale(ev.force, s);
     ev.stiff = unscale_matrix(ev.stiff, s);
     ev
 }
 
-/// [`adhesion_eval`] from the committed bond state, Δt [s] and tributary area [m²].
-fn adhesion_at(bond0: BondState, dt: f64, area: f64, a: &RccParams, x: V3) -> AdhEval {
+/// The RCC law `a` at `x` from the committed bond state, Δt [s] and tributary area [m²]
+/// (its [`Interface::adhesion_at`]).
+pub(super) fn rcc_adhesion_at(
+    bond0: BondState,
+    dt: f64,
+    area: f64,
+    a: &RccParams,
+    x: V3,
+) -> AdhEval {
     let a = &a.degraded(bond0.damage);
     let ut = [bond0.ut[0] + x[0], bond0.ut[1] + x[1]];
     let e = stretch_energy(a, x[2], ut);
@@ -1011,7 +1070,7 @@ pub fn adhesive_response(
     area: f64,
     x: [f64; 3],
 ) -> AdhesiveResponse {
-    let ev = adhesion_at(bond0, dt, area, a, x);
+    let ev = rcc_adhesion_at(bond0, dt, area, a, x);
     let k = area * ev.beta * ev.beta;
     let mut secant_stiffness = [[0.0; 3]; 3];
     if ev.beta > 0.0 {
@@ -1032,24 +1091,21 @@ pub fn adhesive_response(
 /// z = −K₀ (y + e + W z), K₀ = A β₀² diag(C_t, C_t, C_n [y_n > 0]), e = (u_t0, 0).
 fn frozen_adhesion_guess(ctx: &Ctx, y: V3) -> V3 {
     let (p, s) = (ctx.p, ctx.t2);
-    let a = match &p.law.adhesion {
-        Some(a) => a,
-        None => return [0.0; 3],
-    };
-    let b0 = clamp01(p.bond0.beta);
-    let k = p.area * b0 * b0;
-    if k.is_nan() || k <= 0.0 {
+    if !p.law.is_adhesive() {
         return [0.0; 3];
     }
+    let Some(FrozenSprings {
+        stiffness: c,
+        stretch: e,
+    }) = p.law.frozen_springs(&p.bond0, p.area)
+    else {
+        return [0.0; 3];
+    };
     // In scaled variables the springs are T⁻¹KT⁻¹ and the stretch T e.
-    let kd = [
-        k * a.ct,
-        k * a.ct2 / (s * s),
-        if y[2] > 0.0 { k * a.cn } else { 0.0 },
-    ];
+    let kd = [c[0], c[1] / (s * s), if y[2] > 0.0 { c[2] } else { 0.0 }];
     let rhs = [
-        -kd[0] * (y[0] + p.bond0.ut[0]),
-        -kd[1] * (y[1] + s * p.bond0.ut[1]),
+        -kd[0] * (y[0] + e[0]),
+        -kd[1] * (y[1] + s * e[1]),
         -kd[2] * y[2],
     ];
     let mut m = identity();
@@ -1068,7 +1124,7 @@ fn frozen_adhesion_guess(ctx: &Ctx, y: V3) -> V3 {
 /// Π(z) = ½ zᵀW z + φ(y + W z), whose stationary points are the solutions; the line search keeps
 /// Π decreasing, so the iteration settles in a local minimum (a stable equilibrium) next to the
 /// starting guess and, past a snap-off, slides down to the detached branch.
-fn solve_adhesion(ctx: &Ctx, a: &RccParams, y: V3, z_start: V3) -> (V3, V3, AdhEval) {
+fn solve_adhesion(ctx: &Ctx, y: V3, z_start: V3) -> (V3, V3, AdhEval) {
     let p = ctx.p;
     let w = p.w_aa;
     let mut z = if z_start.iter().all(|v| v.is_finite()) {
@@ -1077,7 +1133,7 @@ fn solve_adhesion(ctx: &Ctx, a: &RccParams, y: V3, z_start: V3) -> (V3, V3, AdhE
         [0.0; 3]
     };
     let mut x = add(y, matvec(w, z));
-    let mut ad = adhesion_eval(ctx, a, x);
+    let mut ad = adhesion_eval(ctx, x);
     for _ in 0..MAX_INNER {
         let res = sub(z, ad.force);
         let size = norm(z) + norm(ad.force) + ctx.scale;
@@ -1112,7 +1168,7 @@ fn solve_adhesion(ctx: &Ctx, a: &RccParams, y: V3, z_start: V3) -> (V3, V3, AdhE
         for _ in 0..MAX_HALVINGS {
             let zt = axpy(z, alpha, d);
             let xt = add(y, matvec(w, zt));
-            let at = adhesion_eval(ctx, a, xt);
+            let at = adhesion_eval(ctx, xt);
             let pit = merit(zt, w, at.energy);
             let slack = 1e-13 * (pi0.abs() + pit.abs());
             if pit <= pi0 + 1e-4 * alpha * slope + slack {
@@ -1124,7 +1180,7 @@ fn solve_adhesion(ctx: &Ctx, a: &RccParams, y: V3, z_start: V3) -> (V3, V3, AdhE
         let (zn, xn, an) = accepted.unwrap_or_else(|| {
             let zt = add(z, d);
             let xt = add(y, matvec(w, zt));
-            (zt, xt, adhesion_eval(ctx, a, xt))
+            (zt, xt, adhesion_eval(ctx, xt))
         });
         let moved = norm(sub(zn, z));
         z = zn;
@@ -1224,7 +1280,7 @@ pub fn projection_jacobian(r_star: V3, mu: f64, case: ContactState) -> M3 {
 // ---------------------------------------------------------------------------------------------
 // Small dense helpers on [f64; 3] and [[f64; 3]; 3].
 
-fn clamp01(v: f64) -> f64 {
+pub(super) fn clamp01(v: f64) -> f64 {
     if v > 1.0 {
         1.0
     } else if v > 0.0 {

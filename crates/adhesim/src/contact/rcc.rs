@@ -4,14 +4,16 @@
 //! start of a step and writes it when the step is committed. Dry Coulomb friction is this law
 //! without adhesion ([`InterfaceLaw::coulomb`]): β stays 0 and D keeps what it had.
 //!
-//! The point solvers evaluate the law itself through [`super::law`] (β update, adhesive force
-//! and its tangent, fatigue, orthotropy).
+//! The same implementation gives the point solvers the law's adhesive force, its tangent and
+//! warm start (evaluated by [`super::law`]: β update, fatigue) and its checks of a pair's
+//! parameters (the adhesive stiffness against the mesh).
 
 use super::history::{FieldKind, HistoryField, LawHistory, NodeHistory, Slot};
 use super::law::{
-    accumulated_damage, adhesive_response, AdhesiveResponse, BondState, Interface, InterfaceLaw,
-    PointSolution,
+    accumulated_damage, adhesive_response, clamp01, rcc_adhesion_at, AdhEval, AdhesiveResponse,
+    BondState, FrozenSprings, Interface, InterfaceLaw, PairScales, PointSolution,
 };
+use crate::warnings::{cohesive_zone_length, CN_STIFFNESS_RATIO};
 
 /// The history of the RCC law at a slave node, between steps.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -83,6 +85,56 @@ impl Interface for InterfaceLaw {
 
     fn bond_traction(&self) -> f64 {
         self.adhesion.map_or(0.0, |a| a.peak_traction())
+    }
+
+    fn is_adhesive(&self) -> bool {
+        self.adhesion.is_some()
+    }
+
+    fn adhesion_at(&self, start: &BondState, dt: f64, area: f64, x: [f64; 3]) -> AdhEval {
+        match &self.adhesion {
+            Some(a) => rcc_adhesion_at(*start, dt, area, a, x),
+            None => AdhEval::default(),
+        }
+    }
+
+    fn warnings(&self, pair: &PairScales, out: &mut Vec<String>) {
+        let (Some(a), Some(area)) = (&self.adhesion, pair.mean_area) else {
+            return;
+        };
+        let (e, nu, h) = (pair.young, pair.poisson, pair.edge);
+        let zone = cohesive_zone_length(e, nu, a.cn);
+        if zone < h {
+            out.push(format!(
+                "contact {:?}: the cohesive zone E*/C_n = {zone:.3e} m (E* = E/(1 − ν²) = {:.3e} Pa, C_n = {:.3e} N/m³) is shorter than the mean slave edge {h:.3e} m (warning below one edge): the peak adhesive traction falls between nodes and de-bonding jumps from node to node; refine the slave surface to a few elements per {zone:.3e} m or lower C_n",
+                pair.name,
+                e / (1.0 - nu * nu),
+                a.cn
+            ));
+        }
+        let link = a.cn * area;
+        let body_stiffness = e * h;
+        let ratio = link / body_stiffness;
+        if ratio > CN_STIFFNESS_RATIO {
+            out.push(format!(
+                "contact {:?}: the adhesive normal stiffness per slave node C_n·A = {link:.3e} N/m (C_n = {:.3e} N/m³, mean tributary area {area:.3e} m²) is {ratio:.3e} times (warning above {CN_STIFFNESS_RATIO:.0e}) the body's stiffness per node E·h = {body_stiffness:.3e} N/m (E = {e:.3e} Pa, mean slave edge {h:.3e} m): the contact solve will be ill-conditioned and may need many sweeps or Δt cut-backs; a smaller C_n gives nearly the same response",
+                pair.name, a.cn
+            ));
+        }
+    }
+
+    /// Springs A β₀² (C_t, C_t2, C_n) at the undegraded stiffnesses, stretched by u_t0.
+    fn frozen_springs(&self, start: &BondState, area: f64) -> Option<FrozenSprings> {
+        let a = self.adhesion.as_ref()?;
+        let b0 = clamp01(start.beta);
+        let k = area * b0 * b0;
+        if k.is_nan() || k <= 0.0 {
+            return None;
+        }
+        Some(FrozenSprings {
+            stiffness: [k * a.ct, k * a.ct2, k * a.cn],
+            stretch: start.ut,
+        })
     }
 
     fn adhesive_response(
