@@ -183,9 +183,9 @@ impl SystemMatrix {
         }
     }
 
-    /// The matrix last factorised: its pattern (upper triangle) and values, with the
-    /// Dirichlet conditions and the ties applied.
-    pub fn factorised_matrix(&self) -> (&BlockPattern, &[f64]) {
+    /// The matrix: its pattern (upper triangle) and values, those last factorised or last
+    /// given the Dirichlet conditions and the ties by [`Self::apply_conditions`].
+    pub fn matrix(&self) -> (&BlockPattern, &[f64]) {
         (&self.pattern, &self.values)
     }
 
@@ -200,7 +200,7 @@ impl SystemMatrix {
         &self.fixed
     }
 
-    /// Replaces the matrix's values by `values` (e.g. those of [`Self::factorised_matrix`]
+    /// Replaces the matrix's values by `values` (e.g. those of [`Self::matrix`]
     /// kept from an earlier factorisation); factorise again before solving.
     pub fn set_values(&mut self, values: &[f64]) {
         self.values.copy_from_slice(values);
