@@ -115,7 +115,7 @@ pub enum ContactSolver {
 
 /// Contact candidates from which [`ContactSolver::Auto`] solves a step without W. Measured
 /// (docs/contact-solver.md): Gauss-Seidel with a reused W is about 10 % faster on the
-/// README example (at most 94 candidates, with adhesion), the semismooth solve about 30 %
+/// README example (at most 47 points in contact, with adhesion), the semismooth solve about 30 %
 /// faster on the pad at 100 contact nodes, 17 % on the 4.4 twist (441) and 3 times at 1,024.
 /// The switch sits above the first, where W is 3 MB.
 pub const AUTO_SEMISMOOTH_FROM: usize = 200;
