@@ -70,37 +70,54 @@ fn missing_file_names_the_file() {
     assert!(err.contains("no-such-problem.hdf5"), "{err}");
 }
 
+/// The two small global problems of the shared data.
+const SMALL_GLOBAL: [&str; 2] = [
+    "LMGC_GFC3D-i00501-4-00000.hdf5",
+    "Box_Stacks-i0122-82-5.hdf5",
+];
+
+/// Siconos's relative error of the forces `r` on the condensed problem `p`, recomputed from
+/// r alone (x = q + W r).
+fn recomputed_error(p: &ReducedProblem, r: &[[f64; 3]]) -> f64 {
+    let mut x = vec![[0.0; 3]; p.w.points()];
+    p.w.apply(r, &p.q, &mut x);
+    relative_error(natural_map_residual(r, &x, &p.mu), &p.q, r, &x)
+}
+
+/// The largest normal force (third local component) [N].
+fn largest_normal_force(r: &[[f64; 3]]) -> f64 {
+    r.iter().map(|r| r[2].abs()).fold(0.0, f64::max)
+}
+
+/// The normal forces of `a` and `b` agree to 1e-5 of the largest of `b`'s.
+fn assert_normal_forces_agree(name: &str, a: &[[f64; 3]], b: &[[f64; 3]]) {
+    let scale = largest_normal_force(b);
+    for (a, b) in a.iter().zip(b) {
+        assert!(
+            (a[2] - b[2]).abs() <= 1e-5 * scale,
+            "{name}: {a:?} vs {b:?}"
+        );
+    }
+}
+
 /// Both solvers reach Siconos's error 1e-8 on both files; the error reported is recomputed
 /// here from r alone (x = q + W r), and Newton and Gauss-Seidel agree on the normal forces to
 /// 1e-5 of the largest (both errors ≤ 1e-8 relative; the problems are well conditioned enough
 /// for the forces to follow to that level).
 #[test]
 fn solves_small_problems_to_1e8() {
-    for name in [
-        "LMGC_GFC3D-i00501-4-00000.hdf5",
-        "Box_Stacks-i0122-82-5.hdf5",
-    ] {
+    for name in SMALL_GLOBAL {
         let file = read(data(name)).expect("readable");
         let p = ReducedProblem::of_file(&file).expect("condensable");
-        let n = p.w.points();
-        let r0 = vec![[0.0; 3]; n];
+        let r0 = vec![[0.0; 3]; p.w.points()];
         let (newton, _) = semismooth_newton(&p.w, &p.q, &p.mu, &r0, 1e-8, 200);
         let gs = gauss_seidel_blocks(&p.w, &p.q, &p.mu, &r0, 1e-8, 10_000);
         for (solver, sol) in [("newton", &newton), ("gauss-seidel", &gs)] {
             assert!(sol.converged, "{name} {solver}: error {}", sol.error);
-            let mut x = vec![[0.0; 3]; n];
-            p.w.apply(&sol.r, &p.q, &mut x);
-            let res = natural_map_residual(&sol.r, &x, &p.mu);
-            let err = relative_error(res, &p.q, &sol.r, &x);
+            let err = recomputed_error(&p, &sol.r);
             assert!(err <= 1e-8, "{name} {solver}: recomputed error {err}");
         }
-        let scale = gs.r.iter().map(|r| r[2].abs()).fold(0.0, f64::max);
-        for (a, b) in newton.r.iter().zip(&gs.r) {
-            assert!(
-                (a[2] - b[2]).abs() <= 1e-5 * scale,
-                "{name}: {a:?} vs {b:?}"
-            );
-        }
+        assert_normal_forces_agree(name, &newton.r, &gs.r);
     }
 }
 
@@ -110,10 +127,7 @@ fn solves_small_problems_to_1e8() {
 /// largest (both at 1e-8, which leaves room of that order for the forces).
 #[test]
 fn global_form_solves_the_small_global_problems() {
-    for name in [
-        "LMGC_GFC3D-i00501-4-00000.hdf5",
-        "Box_Stacks-i0122-82-5.hdf5",
-    ] {
+    for name in SMALL_GLOBAL {
         let file = read(data(name)).expect("readable");
         let Problem::Global(global) = &file.problem else {
             panic!("{name} is a global problem");
@@ -121,19 +135,12 @@ fn global_form_solves_the_small_global_problems() {
         let sol = adhesim_fclib::solve_global(global, 1e-8, 200).expect("solvable");
         assert!(sol.converged, "{name}: error {}", sol.error);
         let p = ReducedProblem::of_file(&file).expect("condensable");
-        let n = p.w.points();
-        let mut x = vec![[0.0; 3]; n];
-        p.w.apply(&sol.r, &p.q, &mut x);
-        let err = relative_error(natural_map_residual(&sol.r, &x, &p.mu), &p.q, &sol.r, &x);
+        let err = recomputed_error(&p, &sol.r);
         assert!(err <= 1e-8, "{name}: recomputed error {err}");
-        let (newton, _) = semismooth_newton(&p.w, &p.q, &p.mu, &vec![[0.0; 3]; n], 1e-8, 200);
-        let scale = newton.r.iter().map(|r| r[2].abs()).fold(0.0, f64::max);
+        let r0 = vec![[0.0; 3]; p.w.points()];
+        let (newton, _) = semismooth_newton(&p.w, &p.q, &p.mu, &r0, 1e-8, 200);
+        let scale = largest_normal_force(&newton.r);
         assert!(scale > 0.0, "{name}: no contact force");
-        for (a, b) in sol.r.iter().zip(&newton.r) {
-            assert!(
-                (a[2] - b[2]).abs() <= 1e-5 * scale,
-                "{name}: {a:?} vs {b:?}"
-            );
-        }
+        assert_normal_forces_agree(name, &sol.r, &newton.r);
     }
 }

@@ -398,6 +398,11 @@ pub struct KrylovOutcome {
     pub relative_residual: f64,
 }
 
+/// Euclidean norm.
+pub fn norm(x: &[f64]) -> f64 {
+    x.iter().map(|a| a * a).sum::<f64>().sqrt()
+}
+
 /// Restarted GMRES with right preconditioning for A x = b, from x = 0: `apply(v, out)` sets
 /// out = A v, `precondition(v)` overwrites v with M⁻¹ v. Stops when the true residual
 /// ‖b − A x‖ ≤ `tol` ‖b‖ or after `max_iter` iterations (restarts every `restart`). Right

@@ -309,7 +309,7 @@ pub struct MixedSolution {
     /// Each point's law at the solution.
     pub points: Vec<PointSolution>,
     /// Change of the unknowns δu = K̄⁻¹(Hᵀ(r − r₀) + m) [m], m the direction's out-of-balance
-    /// force ([`MixedDirection::momentum_norm`]; zero for most).
+    /// force ([`MixedDirection::momentum`]; zero for most).
     pub du: Vec<f64>,
     /// The caller's measure of the residual at the end [N].
     pub residual: f64,
@@ -338,10 +338,10 @@ pub trait MixedDirection {
     fn eta_floor(&self) -> f64 {
         ETA_MIN
     }
-    /// The norm of the out-of-balance force m the directions also remove [N] (zero when the
-    /// displacement part has no right-hand side of its own).
-    fn momentum_norm(&self) -> f64 {
-        0.0
+    /// The out-of-balance force m the directions also remove, on the unknowns [N] (empty
+    /// when the displacement part has no right-hand side of its own).
+    fn momentum(&self) -> &[f64] {
+        &[]
     }
     /// The direction for the linearisations `lin` with regularisation `eta` [m/N], of the
     /// mixed system whose displacement part has the right-hand side `momentum` m; `None` when
@@ -369,8 +369,8 @@ impl MixedDirection for LuDirection<'_, '_> {
         self.op.n()
     }
 
-    fn momentum_norm(&self) -> f64 {
-        self.momentum.iter().map(|v| v * v).sum::<f64>().sqrt()
+    fn momentum(&self) -> &[f64] {
+        self.momentum
     }
 
     fn direction(
@@ -444,7 +444,7 @@ pub fn solve_mixed(
     let (mut iterations, mut stalled, mut failed) = (0, false, false);
     // The part of the out-of-balance force m still to remove: s m, with s = Π(1 − t) over
     // the steps t taken. It enters the merit as ½ (s ‖m‖)².
-    let m_norm = dir.momentum_norm();
+    let m_norm = crate::linalg::norm(dir.momentum());
     let mut s = 1.0;
     loop {
         let points: Vec<PointSolution> = lin.iter().map(|l| l.solution).collect();

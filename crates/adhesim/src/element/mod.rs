@@ -364,14 +364,7 @@ pub fn element_response_with_history<const N: usize, const G: usize>(
         energy += w_point * gp.weight;
         let w = gp.weight;
         let bs: [Bmat; N] = std::array::from_fn(|a| b_matrix(&fb, &gp.grad[a]));
-        let sv = nalgebra::Vector6::new(
-            s[(0, 0)],
-            s[(1, 1)],
-            s[(2, 2)],
-            s[(0, 1)],
-            s[(1, 2)],
-            s[(0, 2)],
-        );
+        let sv = nalgebra::Vector6::from(crate::material::to_voigt(&s));
         for a in 0..N {
             let fa = bs[a].transpose() * sv;
             for i in 0..3 {

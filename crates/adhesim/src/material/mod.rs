@@ -56,7 +56,7 @@ pub use ogden::Ogden;
 pub use saint_venant_kirchhoff::SaintVenantKirchhoff;
 pub use uncoupled::bulk_from_d1;
 pub use uncoupled_neo_hookean::UncoupledNeoHookean;
-pub use viscoelastic::{PronyTerm, Viscoelastic};
+pub use viscoelastic::{to_voigt, PronyTerm, Viscoelastic};
 
 /// Tensor index pairs (i, j) of the six Voigt components, in the order (11, 22, 33, 12, 23, 13).
 pub const VOIGT_PAIRS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2)];

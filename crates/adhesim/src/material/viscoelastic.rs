@@ -37,7 +37,8 @@ pub struct Viscoelastic {
     pub terms: Vec<PronyTerm>,
 }
 
-fn to_voigt(s: &Mat3) -> [f64; 6] {
+/// A symmetric tensor's components in Voigt order (11, 22, 33, 12, 23, 13).
+pub fn to_voigt(s: &Mat3) -> [f64; 6] {
     [
         s[(0, 0)],
         s[(1, 1)],

@@ -2,6 +2,7 @@
 //! out-of-balance force G(u₁) without contact, the step's potential whose gradient it is, the
 //! coefficients of K̄, the end velocity and the work done over the step.
 
+pub use crate::linalg::norm;
 use crate::linalg::BlockPattern;
 
 /// Mass and damping matrices, stored on the discretisation's block pattern.
@@ -249,9 +250,4 @@ impl<'a> ThetaStep<'a> {
             .sum::<f64>()
             .sqrt()
     }
-}
-
-/// Euclidean norm.
-pub fn norm(x: &[f64]) -> f64 {
-    x.iter().map(|a| a * a).sum::<f64>().sqrt()
 }

@@ -321,8 +321,8 @@ impl MixedDirection for CondensedDirection<'_> {
         ETA_FLOOR
     }
 
-    fn momentum_norm(&self) -> f64 {
-        self.momentum.iter().map(|v| v * v).sum::<f64>().sqrt()
+    fn momentum(&self) -> &[f64] {
+        self.momentum
     }
 
     fn direction(
