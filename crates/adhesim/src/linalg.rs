@@ -292,8 +292,88 @@ pub struct SparseCholesky {
     symbolic: SymbolicCholesky<usize>,
     l_values: Vec<f64>,
     mem: MemBuffer,
-    par: Par,
+    /// Threads of the numeric factorisation.
+    factorise_par: ParChoice,
+    /// Threads of a solve with a block of right-hand sides.
+    block_par: Par,
     factorised: bool,
+}
+
+/// Calls of each mode timed before [`ParChoice`] settles.
+const PAR_TRIALS: usize = 3;
+
+/// Sequential or parallel: whichever is faster on this matrix and this machine, measured.
+///
+/// faer's parallel supernodal factorisation pays off on a bulky 3D block in isolation (20³:
+/// 0.81× the sequential time on 2 threads, bench/results.md §3) but not inside a run, where
+/// thin bodies have narrow elimination trees and the pool's threads are woken for every
+/// call: the 3,136-node pad took 1.24× and the 4.4 twist 1.27× its sequential time with 2
+/// threads (docs/performance.md). The two modes give bit-identical factors (faer splits the
+/// elimination tree, not the sums), so timing the first calls of each, alternating, and
+/// keeping the faster for the rest is free of any effect on the results.
+#[derive(Clone, Debug)]
+enum ParChoice {
+    /// Settled (or only one thread).
+    Fixed(Par),
+    /// Still timing: seconds of the sequential and of the parallel calls so far.
+    Trial {
+        threads: usize,
+        seq: Vec<f64>,
+        par: Vec<f64>,
+    },
+}
+
+impl ParChoice {
+    fn new(threads: usize) -> Self {
+        if threads == 1 {
+            ParChoice::Fixed(Par::Seq)
+        } else {
+            ParChoice::Trial {
+                threads,
+                seq: Vec::new(),
+                par: Vec::new(),
+            }
+        }
+    }
+
+    /// The mode of the next call: the settled one, or the one with fewer timings (parallel
+    /// first).
+    fn next(&self) -> Par {
+        match self {
+            ParChoice::Fixed(p) => *p,
+            ParChoice::Trial { threads, seq, par } => {
+                if par.len() <= seq.len() {
+                    Par::rayon(*threads)
+                } else {
+                    Par::Seq
+                }
+            }
+        }
+    }
+
+    /// Records that a call in mode `mode` took `seconds`; settles after [`PAR_TRIALS`] of each.
+    fn record(&mut self, mode: Par, seconds: f64) {
+        if let ParChoice::Trial { threads, seq, par } = self {
+            match mode {
+                Par::Seq => seq.push(seconds),
+                _ => par.push(seconds),
+            }
+            if seq.len() >= PAR_TRIALS && par.len() >= PAR_TRIALS {
+                let faster = if median(seq) <= median(par) {
+                    Par::Seq
+                } else {
+                    Par::rayon(*threads)
+                };
+                *self = ParChoice::Fixed(faster);
+            }
+        }
+    }
+}
+
+fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    s[s.len() / 2]
 }
 
 impl SparseCholesky {
@@ -317,6 +397,11 @@ impl SparseCholesky {
             CholeskySymbolicParams::default(),
         )
         .map_err(|e| LinalgError::Symbolic(format!("{e:?}")))?;
+        let threads = if threads == 0 {
+            rayon::current_num_threads()
+        } else {
+            threads
+        };
         let par = if threads == 1 {
             Par::Seq
         } else {
@@ -334,7 +419,8 @@ impl SparseCholesky {
             symbolic,
             l_values,
             mem,
-            par,
+            factorise_par: ParChoice::new(threads),
+            block_par: par,
             factorised: false,
         })
     }
@@ -349,17 +435,21 @@ impl SparseCholesky {
         self.factorised = false;
         let a = SparseColMatRef::new(self.pattern.as_ref(), values);
         let stack = MemStack::new(&mut self.mem);
+        let par = self.factorise_par.next();
+        let clock = std::time::Instant::now();
         self.symbolic
             .factorize_numeric_llt(
                 &mut self.l_values,
                 a,
                 Side::Upper,
                 LltRegularization::default(),
-                self.par,
+                par,
                 stack,
                 Spec::default(),
             )
             .map_err(|_| LinalgError::NotPositiveDefinite)?;
+        self.factorise_par
+            .record(par, clock.elapsed().as_secs_f64());
         self.factorised = true;
         Ok(())
     }
@@ -372,15 +462,24 @@ impl SparseCholesky {
         if n == 0 {
             return;
         }
-        let ncols = rhs.len() / n;
         let llt = LltRef::new(&self.symbolic, &self.l_values);
+        // One right-hand side (Newton corrections, GMRES's preconditioner) is solved on one
+        // thread: its triangular solves are short and memory-bound, and waking the pool for
+        // each cost the 4.4 twist 45 % more contact-solve time (docs/performance.md). Unlike
+        // the factorisation, the parallel solve sums in another order, so the choice is fixed
+        // rather than timed: results must not depend on the machine's load.
+        let par = if rhs.len() == n {
+            Par::Seq
+        } else {
+            self.block_par
+        };
         for chunk in rhs.chunks_mut(64 * n) {
             let k = chunk.len() / n;
             let mat = MatMut::from_column_major_slice_mut(chunk, n, k);
             let stack = MemStack::new(&mut self.mem);
-            llt.solve_in_place_with_conj(Conj::No, mat, self.par, stack);
+            llt.solve_in_place_with_conj(Conj::No, mat, par, stack);
         }
-        let _ = ncols;
+
     }
 
     /// The scalar symbolic pattern (upper triangle).
@@ -562,6 +661,66 @@ mod tests {
         for d in 0..15 {
             assert_eq!(p.row_idx[p.diagonal_position(d)], d);
         }
+    }
+
+    /// A cube of n³ nodes in hex cells, each node coupled to its 26 neighbours: SPD by strict
+    /// diagonal dominance (diagonal 4, off-diagonal row sums ≤ 26·3·0.04 = 3.12).
+    fn grid_matrix(n: usize) -> (BlockPattern, Vec<f64>) {
+        let id = |i: usize, j: usize, k: usize| (k * n + j) * n + i;
+        let mut cells = Vec::new();
+        for k in 0..n - 1 {
+            for j in 0..n - 1 {
+                for i in 0..n - 1 {
+                    cells.push(std::array::from_fn::<usize, 8, _>(|c| {
+                        id(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2))
+                    }));
+                }
+            }
+        }
+        let pattern = BlockPattern::from_cells(n * n * n, cells.iter().map(|c| &c[..]));
+        let mut values = vec![0.0; pattern.nnz()];
+        for b in 0..n * n * n {
+            for &a in &pattern.upper_neighbours[b] {
+                let r = pattern.rank(a, b).unwrap();
+                for k in 0..3 {
+                    for i in 0..3 {
+                        if a == b && i > k {
+                            continue;
+                        }
+                        let off = -0.04 + 0.001 * ((a * 7 + b * 3 + i + k) % 5) as f64;
+                        let v = if a == b && i == k { 4.0 } else { off };
+                        values[pattern.position(r, b, i, k)] = v;
+                    }
+                }
+            }
+        }
+        (pattern, values)
+    }
+
+    /// The factorisation times its first calls sequential and parallel, alternating, before it
+    /// keeps the faster: the factors must be the same to the bit, or the results of a run
+    /// would depend on the machine's load.
+    #[test]
+    fn sequential_and_parallel_factors_are_identical() {
+        let (p, values) = grid_matrix(14);
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        pool.install(|| {
+            let mut chol = SparseCholesky::analyse(&p, 2).unwrap();
+            let mut factors = Vec::new();
+            let mut modes = Vec::new();
+            for _ in 0..2 * PAR_TRIALS + 1 {
+                modes.push(matches!(chol.factorise_par.next(), Par::Seq));
+                chol.factorise(&values).unwrap();
+                factors.push(chol.l_values.clone());
+            }
+            assert!(modes[..2 * PAR_TRIALS].iter().any(|&s| s), "a sequential trial");
+            assert!(modes[..2 * PAR_TRIALS].iter().any(|&s| !s), "a parallel trial");
+            assert!(matches!(chol.factorise_par, ParChoice::Fixed(_)), "settled");
+            for (c, f) in factors.iter().enumerate() {
+                let same = f.iter().zip(&factors[0]).all(|(a, b)| a.to_bits() == b.to_bits());
+                assert!(same, "factor {c} differs from the first");
+            }
+        });
     }
 
     #[test]
