@@ -304,13 +304,14 @@ const PAR_TRIALS: usize = 3;
 
 /// Sequential or parallel: whichever is faster on this matrix and this machine, measured.
 ///
-/// faer's parallel supernodal factorisation pays off on a bulky 3D block in isolation (20³:
-/// 0.81× the sequential time on 2 threads, bench/results.md §3) but not inside a run, where
+/// faer's parallel supernodal factorisation pays off on a bulky 3D block factorised alone
+/// (`bench_core --sizes 20,30 --threads 1,2`: 0.81× and 0.69× the sequential time on 2
+/// threads) but not always inside a run, where
 /// thin bodies have narrow elimination trees and the pool's threads are woken for every
 /// call: the 3,136-node pad took 1.24× and the 4.4 twist 1.27× its sequential time with 2
-/// threads (docs/performance.md). The two modes give bit-identical factors (faer splits the
-/// elimination tree, not the sums), so timing the first calls of each, alternating, and
-/// keeping the faster for the rest is free of any effect on the results.
+/// /// threads (docs/running.md, *Threads*). The two modes give bit-identical factors (the test
+/// below, and the histories of both runs), so timing the first calls of each, alternating,
+/// and keeping the faster for the rest has no effect on the results.
 #[derive(Clone, Debug)]
 enum ParChoice {
     /// Settled (or only one thread).
@@ -465,7 +466,7 @@ impl SparseCholesky {
         let llt = LltRef::new(&self.symbolic, &self.l_values);
         // One right-hand side (Newton corrections, GMRES's preconditioner) is solved on one
         // thread: its triangular solves are short and memory-bound, and waking the pool for
-        // each cost the 4.4 twist 45 % more contact-solve time (docs/performance.md). Unlike
+        // each cost the 4.4 twist 45 % more contact-solve time (docs/running.md). Unlike
         // the factorisation, the parallel solve sums in another order, so the choice is fixed
         // rather than timed: results must not depend on the machine's load.
         let par = if rhs.len() == n {
@@ -479,7 +480,6 @@ impl SparseCholesky {
             let stack = MemStack::new(&mut self.mem);
             llt.solve_in_place_with_conj(Conj::No, mat, par, stack);
         }
-
     }
 
     /// The scalar symbolic pattern (upper triangle).
@@ -703,7 +703,10 @@ mod tests {
     #[test]
     fn sequential_and_parallel_factors_are_identical() {
         let (p, values) = grid_matrix(14);
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
         pool.install(|| {
             let mut chol = SparseCholesky::analyse(&p, 2).unwrap();
             let mut factors = Vec::new();
@@ -713,11 +716,20 @@ mod tests {
                 chol.factorise(&values).unwrap();
                 factors.push(chol.l_values.clone());
             }
-            assert!(modes[..2 * PAR_TRIALS].iter().any(|&s| s), "a sequential trial");
-            assert!(modes[..2 * PAR_TRIALS].iter().any(|&s| !s), "a parallel trial");
+            assert!(
+                modes[..2 * PAR_TRIALS].iter().any(|&s| s),
+                "a sequential trial"
+            );
+            assert!(
+                modes[..2 * PAR_TRIALS].iter().any(|&s| !s),
+                "a parallel trial"
+            );
             assert!(matches!(chol.factorise_par, ParChoice::Fixed(_)), "settled");
             for (c, f) in factors.iter().enumerate() {
-                let same = f.iter().zip(&factors[0]).all(|(a, b)| a.to_bits() == b.to_bits());
+                let same = f
+                    .iter()
+                    .zip(&factors[0])
+                    .all(|(a, b)| a.to_bits() == b.to_bits());
                 assert!(same, "factor {c} differs from the first");
             }
         });
