@@ -19,7 +19,7 @@ use crate::contact::mixed::{
 };
 use crate::contact::newton::add_contact_tangent;
 use crate::contact::newton::RHO_FACTOR;
-use crate::linalg::gmres;
+use crate::linalg::gmres_with_remainder;
 use crate::system::SystemMatrix;
 use crate::Mat3;
 use std::time::Instant;
@@ -376,19 +376,27 @@ impl MixedDirection for CondensedDirection<'_> {
             .collect();
         let h = self.h;
         let (pattern, values, factor) = self.system.operator_and_factor();
-        let apply = |v: &[f64], out: &mut [f64]| {
+        // Only the points whose S the preconditioner leaves part of.
+        let rest: Vec<(&Vec<(usize, [f64; 3])>, Mat3)> = h
+            .iter()
+            .zip(rest)
+            .filter(|(_, ra)| ra.iter().any(|&e| e != 0.0))
+            .collect();
+        let remainder = |v: &[f64], out: &mut [f64]| {
             out.iter_mut().for_each(|o| *o = 0.0);
-            pattern.symmetric_matvec(values, v, out);
-            for (ha, ra) in h.iter().zip(&rest) {
-                if ra.iter().any(|&e| e != 0.0) {
-                    let hv = nalgebra::Vector3::from(apply_h_terms(ha, v));
-                    add_ht_terms(ha, (ra * hv).into(), out);
-                }
+            for (ha, ra) in &rest {
+                let hv = nalgebra::Vector3::from(apply_h_terms(ha, v));
+                add_ht_terms(ha, (ra * hv).into(), out);
             }
         };
+        let apply = |v: &[f64], out: &mut [f64]| {
+            remainder(v, out);
+            pattern.symmetric_matvec(values, v, out);
+        };
         let precondition = |v: &mut [f64]| factor.solve_in_place(v);
-        let (du, outcome) = gmres(
+        let (du, outcome) = gmres_with_remainder(
             apply,
+            remainder,
             precondition,
             &rhs,
             GMRES_TOL,
