@@ -24,7 +24,8 @@ use std::path::{Path, PathBuf};
 pub const FILE_NAME: &str = "checkpoint.bin";
 
 const MAGIC: &[u8; 8] = b"ADHCKPT\0";
-const FORMAT: u32 = 5;
+/// The checkpoint format this version writes.
+pub const FORMAT: u32 = 5;
 /// The previous format, still read: it stored the RCC law's history (β, u_t, D), the only
 /// law then, among each contact node's other values.
 const FORMAT_RCC_ONLY: u32 = 4;
@@ -36,6 +37,8 @@ pub struct Checkpoint {
     pub version: String,
     /// [`fingerprint`] of the problem.
     pub fingerprint: u64,
+    /// The file format it was read from ([`FORMAT`] for one written by this version).
+    pub format: u32,
     /// The stepper's state.
     pub snapshot: Snapshot,
     /// How far the frame writer got.
@@ -147,6 +150,18 @@ impl Checkpoint {
                 self.version
             )));
         }
+        if self.fingerprint != fingerprint(problem) && self.format != FORMAT {
+            // The fingerprint hashes the problem as this build describes it, and the builds
+            // that wrote the older format described the same scenario differently.
+            return Err(mismatch(format!(
+                "it was written in checkpoint format {} by an earlier build of adhesim \
+                 {version}, whose description of a scenario differs from this build's even \
+                 when the scenario file is the same; finish the run with the build that \
+                 started it, or start it again (this build resumes checkpoints of format \
+                 {FORMAT})",
+                self.format
+            )));
+        }
         if self.fingerprint != fingerprint(problem) {
             return Err(mismatch(
                 "the scenario differs from the one the run was started with (meshes, \
@@ -204,6 +219,7 @@ impl Checkpoint {
         let mut checkpoint = Checkpoint {
             version: String::new(),
             fingerprint: 0,
+            format,
             snapshot: Snapshot {
                 t: 0.0,
                 step: 0,
@@ -483,8 +499,9 @@ mod tests {
             tangent_axes: [[1.0, 0.0, 0.0], [0.0, 1.0 / 3.0, 0.7]],
         };
         Checkpoint {
-            version: "0.1.0".into(),
+            version: env!("CARGO_PKG_VERSION").into(),
             fingerprint: 0x1234_5678_9abc_def0,
+            format: FORMAT,
             snapshot: Snapshot {
                 t: 0.1 + 0.2,
                 step: 7,
@@ -591,5 +608,28 @@ mod tests {
             fingerprint(&problem(1.0)),
             fingerprint(&problem(1.0000000000000002))
         );
+        // A checkpoint for another problem: a changed scenario in the current format, an
+        // earlier build in the older one (it cannot tell the two apart, so it says so).
+        let dir = Path::new("out/p");
+        let current = Checkpoint::decode(&sample().encode()).unwrap();
+        let err = current
+            .check_matches(&problem(1.0), dir)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("the scenario differs"), "{err}");
+        let older = Checkpoint::decode(&sample().encode_as(FORMAT_RCC_ONLY)).unwrap();
+        assert_eq!(older.format, FORMAT_RCC_ONLY);
+        let err = older
+            .check_matches(&problem(1.0), dir)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("checkpoint format 4 by an earlier build"),
+            "{err}"
+        );
+        assert!(err.contains("out/p/checkpoint.bin"), "{err}");
+        let mut same = older.clone();
+        same.fingerprint = fingerprint(&problem(1.0));
+        assert!(same.check_matches(&problem(1.0), dir).is_ok());
     }
 }

@@ -289,6 +289,7 @@ pub fn run_with(
         let c = Checkpoint {
             version: summary.version.clone(),
             fingerprint,
+            format: crate::checkpoint::FORMAT,
             snapshot: stepper.snapshot(),
             frames: frames.progress(),
             history_rows: history.rows_written(),
