@@ -54,6 +54,14 @@ def pad_elements(n, layers, node_id):
     return elements
 
 
+def num(x):
+    """x for a CalculiX card: shortest round trip, or 15 significant digits when that is
+    longer than the 20 characters CalculiX reads in a field (e.g. 5.8139534883720933e-05,
+    a node spacing at n = 172)."""
+    s = f"{x:.17g}"
+    return s if len(s) <= 20 else f"{x:.15g}"
+
+
 def write_lines(out, ids, per_line=16):
     for s in range(0, len(ids), per_line):
         out.write(", ".join(str(x) for x in ids[s:s + per_line]) + "\n")
@@ -67,7 +75,7 @@ def write_deck(out, a):
     out.write(f"** n = {n}, layers = {layers}, contact nodes = {(n + 1) ** 2}\n")
     out.write("*NODE, NSET=PAD\n")
     for nid, x, y, z in coords:
-        out.write(f"{nid}, {x:.17g}, {y:.17g}, {z:.17g}\n")
+        out.write(f"{nid}, {num(x)}, {num(y)}, {num(z)}\n")
     # The rigid block: one element under the pad, overhanging it by half a width.
     first = len(coords) + 1
     lo, hi, depth_block = -0.5 * a.width, 1.5 * a.width, a.height
@@ -75,7 +83,7 @@ def write_deck(out, a):
              (lo, -depth_block, hi), (hi, -depth_block, hi), (hi, 0.0, hi), (lo, 0.0, hi)]
     out.write("*NODE, NSET=RIGID\n")
     for m, (x, y, z) in enumerate(block):
-        out.write(f"{first + m}, {x:.17g}, {y:.17g}, {z:.17g}\n")
+        out.write(f"{first + m}, {num(x)}, {num(y)}, {num(z)}\n")
     out.write("*ELEMENT, TYPE=C3D8, ELSET=EPAD\n")
     for eid, _, conn in elements:
         out.write(f"{eid}, " + ", ".join(str(c) for c in conn) + "\n")
