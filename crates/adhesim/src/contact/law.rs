@@ -1381,6 +1381,11 @@ fn eig_sym3(a: &Mat3) -> Vec3 {
 mod tests {
     use super::*;
 
+    /// A force or displacement in local components, as the public functions take it.
+    type V3 = [f64; 3];
+    /// A 3×3 block in rows, as the public functions take it.
+    type M3 = [[f64; 3]; 3];
+
     /// Deterministic generator for randomised tests (splitmix64).
     struct Rng(u64);
 
@@ -1400,7 +1405,7 @@ mod tests {
 
         /// Random symmetric positive definite matrix with eigenvalues in [lo, hi].
         fn spd(&mut self, lo: f64, hi: f64) -> M3 {
-            let mut q = [[0.0; 3]; 3];
+            let mut q = [Vec3::zeros(); 3];
             for row in q.iter_mut() {
                 for v in row.iter_mut() {
                     *v = self.uniform(-1.0, 1.0);
@@ -1409,11 +1414,11 @@ mod tests {
             // Gram-Schmidt on the rows.
             for i in 0..3 {
                 for k in 0..i {
-                    let d = dot(q[i], q[k]);
-                    q[i] = axpy(q[i], -d, q[k]);
+                    let d = q[i].dot(&q[k]);
+                    q[i] = q[i] - q[k] * d;
                 }
-                let n = norm(q[i]);
-                q[i] = [q[i][0] / n, q[i][1] / n, q[i][2] / n];
+                let n = q[i].norm();
+                q[i] /= n;
             }
             let l = [lo, self.uniform(lo, hi), hi];
             let mut m = [[0.0; 3]; 3];
@@ -1435,8 +1440,9 @@ mod tests {
     }
 
     fn assert_vec_close(a: V3, b: V3, tol: f64) {
-        let s = norm(a).max(norm(b)).max(f64::MIN_POSITIVE);
-        assert!(norm(sub(a, b)) <= tol * s, "{a:?} vs {b:?} (tol {tol})");
+        let (va, vb) = (Vec3::from(a), Vec3::from(b));
+        let s = va.norm().max(vb.norm()).max(f64::MIN_POSITIVE);
+        assert!((va - vb).norm() <= tol * s, "{a:?} vs {b:?} (tol {tol})");
     }
 
     const DRY: InterfaceLaw = InterfaceLaw {
@@ -1465,21 +1471,22 @@ mod tests {
     /// Independent check of a point solution against the laws of docs/model.md §5: x = x_free + W r,
     /// r̄ ∈ K_μ, Signorini complementarity, Coulomb sliding rule, and the RCC part.
     fn check_solution(p: &PointProblem, s: &PointSolution, tol: f64) {
-        let r = s.r();
-        let x = add(p.x_free, matvec(p.w_aa, r));
-        let xs = norm(p.x_free).max(norm(x)).max(f64::MIN_POSITIVE);
-        let parts = xs + norm(matvec(p.w_aa, s.r_dry)) + norm(matvec(p.w_aa, s.r_adh));
+        let r = Vec3::from(s.r());
+        let (w, x_free) = (mat3(p.w_aa), Vec3::from(p.x_free));
+        let x = x_free + w * r;
+        let xs = x_free.norm().max(x.norm()).max(f64::MIN_POSITIVE);
+        let parts = xs + (w * Vec3::from(s.r_dry)).norm() + (w * Vec3::from(s.r_adh)).norm();
         assert!(
-            norm(sub(x, s.x)) <= 1e-12 * parts,
+            (x - Vec3::from(s.x)).norm() <= 1e-12 * parts,
             "x = x_free + W r: {x:?} vs {:?} ({s:?}, {p:?})",
             s.x
         );
         let mu = p.law.mu;
-        let fs = norm(r) + p.rho * norm(p.x_free);
+        let fs = r.norm() + p.rho * x_free.norm();
         let rd = s.r_dry;
         assert!(rd[2] >= 0.0, "dry normal force is compressive");
-        assert!(norm2(rd[0], rd[1]) <= mu * rd[2] * (1.0 + 1e-12) + 1e-300);
-        let xt = norm2(x[0], x[1]);
+        assert!(rd[0].hypot(rd[1]) <= mu * rd[2] * (1.0 + 1e-12) + 1e-300);
+        let xt = x[0].hypot(x[1]);
         match s.state {
             ContactState::Apart => {
                 assert_eq!(rd, [0.0; 3]);
@@ -1491,7 +1498,7 @@ mod tests {
             }
             ContactState::Slide => {
                 assert!(x[2].abs() <= tol * xs, "slide gap {}", x[2]);
-                let rt = norm2(rd[0], rd[1]);
+                let rt = rd[0].hypot(rd[1]);
                 assert!((rt - mu * rd[2]).abs() <= tol * fs, "on the cone");
                 if rt > tol * fs && xt > tol * xs {
                     let c = (rd[0] * x[0] + rd[1] * x[1]) / (rt * xt);
@@ -1506,9 +1513,9 @@ mod tests {
                 let beta = beta_update(p.bond0.beta, p.dt, a, x[2], ut);
                 assert!((beta - s.beta).abs() <= 1e-9, "β {beta} vs {}", s.beta);
                 let ra = adhesive_force(beta, a, x[2], ut, p.area);
-                let scale = norm(ra) + p.area * a.peak_traction();
+                let scale = Vec3::from(ra).norm() + p.area * a.peak_traction();
                 assert!(
-                    norm(sub(ra, s.r_adh)) <= tol * scale,
+                    (Vec3::from(ra) - Vec3::from(s.r_adh)).norm() <= tol * scale,
                     "{ra:?} vs {:?}",
                     s.r_adh
                 );
@@ -1560,12 +1567,13 @@ mod tests {
         let rs = [1.5, -2.0, 0.4];
         let (r, c) = dry_projection(rs, mu);
         assert_eq!(c, ContactState::Slide);
-        let st = norm2(rs[0], rs[1]);
+        let st = rs[0].hypot(rs[1]);
         let t = [rs[0] / st, rs[1] / st];
         let k = (st - mu * rs[2]) / (1.0 + mu * mu);
-        assert_vec_close(sub(rs, r), [k * t[0], k * t[1], -k * mu], 1e-14);
+        let y = Vec3::from(rs) - Vec3::from(r);
+        assert_vec_close(y.into(), [k * t[0], k * t[1], -k * mu], 1e-14);
         let gen = [mu * t[0], mu * t[1], 1.0];
-        assert!(dot(sub(rs, r), gen).abs() <= 1e-14 * norm(rs));
+        assert!(y.dot(&Vec3::from(gen)).abs() <= 1e-14 * Vec3::from(rs).norm());
         let rn = r[2];
         assert_vec_close(r, [rn * gen[0], rn * gen[1], rn * gen[2]], 1e-14);
     }
@@ -1578,7 +1586,7 @@ mod tests {
         let printed = [rs[0] - k, rs[1], rs[2] - k * mu];
         assert!(printed[2] < 0.0, "printed sign gives r_n = {}", printed[2]);
         let (ours, _) = dry_projection(rs, mu);
-        assert!(ours[2] > 0.0 && (norm2(ours[0], ours[1]) - mu * ours[2]).abs() < 1e-15);
+        assert!(ours[2] > 0.0 && (ours[0].hypot(ours[1]) - mu * ours[2]).abs() < 1e-15);
     }
 
     #[test]
@@ -1599,32 +1607,35 @@ mod tests {
             ];
             let (r, c) = dry_projection(rs, mu);
             hits[c as usize] += 1;
-            let s = norm(rs);
+            let s = Vec3::from(rs).norm();
             let tol = 1e-12 * s;
             // In the cone.
             assert!(r[2] >= 0.0);
-            assert!(norm2(r[0], r[1]) <= mu * r[2] + tol, "{rs:?} μ={mu}");
+            assert!(r[0].hypot(r[1]) <= mu * r[2] + tol, "{rs:?} μ={mu}");
             // Idempotent.
             let (rr, cc) = dry_projection(r, mu);
-            assert!(norm(sub(rr, r)) <= tol, "idempotence {rs:?} μ={mu}");
-            if norm(r) > 0.0 {
+            assert!(
+                (Vec3::from(rr) - Vec3::from(r)).norm() <= tol,
+                "idempotence {rs:?} μ={mu}"
+            );
+            if Vec3::from(r).norm() > 0.0 {
                 assert_ne!(cc, ContactState::Apart);
             }
             // Moreau: y = r* − r lies in the polar cone {μ‖y_t‖ ≤ −y_n} and y ⊥ r.
-            let y = sub(rs, r);
-            assert!(mu * norm2(y[0], y[1]) + y[2] <= tol, "polar {rs:?} μ={mu}");
+            let y = Vec3::from(rs) - Vec3::from(r);
+            assert!(mu * y[0].hypot(y[1]) + y[2] <= tol, "polar {rs:?} μ={mu}");
             assert!(
-                dot(y, r).abs() <= 1e-12 * s * s,
+                y.dot(&Vec3::from(r)).abs() <= 1e-12 * s * s,
                 "orthogonality {rs:?} μ={mu}"
             );
             // Nearest point: no random point of the cone is closer.
-            let d = norm(y);
+            let d = y.norm();
             for _ in 0..4 {
                 let kn = mag * rng.uniform(0.0, 2.0);
                 let ang = rng.uniform(0.0, 2.0 * PI);
                 let kt = mu * kn * rng.uniform(0.0, 1.0);
                 let k = [kt * ang.cos(), kt * ang.sin(), kn];
-                assert!(norm(sub(rs, k)) >= d - tol);
+                assert!((Vec3::from(rs) - Vec3::from(k)).norm() >= d - tol);
             }
         }
         assert!(hits.iter().all(|&h| h > 1000), "all cases hit: {hits:?}");
@@ -1944,7 +1955,7 @@ mod tests {
         for _ in 0..1000 {
             let hi = 10f64.powf(rng.uniform(-6.9, -3.0));
             let w = rng.spd(1e-7, hi);
-            let ev = eig_sym3(w);
+            let ev = eig_sym3(&mat3(w));
             let hi = w
                 .iter()
                 .map(|r| r.iter().map(|v| v.abs()).sum::<f64>())
@@ -1975,7 +1986,7 @@ mod tests {
         let s = solve_point(&p, [0.0; 3], 1e-12, 50);
         assert!(s.converged);
         assert_eq!(s.state, ContactState::Stick);
-        assert!(norm2(s.x[0], s.x[1]) <= 1e-12 * 1e-4);
+        assert!(s.x[0].hypot(s.x[1]) <= 1e-12 * 1e-4);
         assert_vec_close(s.r(), [-10.0, 0.0, 50.0], 1e-10);
         check_solution(&p, &s, 1e-10);
         // Slide: the sticking force would be 50 N > 15 N.
@@ -2204,8 +2215,11 @@ mod tests {
             let nw = solve_point(&p, [0.0; 3], 1e-10, 50);
             assert!(nw.converged);
             assert_eq!(fp.state, nw.state, "case {i}");
-            let scale = norm(fp.r()) + p.rho * norm(x_free);
-            assert!(norm(sub(fp.r(), nw.r())) <= 1e-8 * scale, "case {i}");
+            let scale = Vec3::from(fp.r()).norm() + p.rho * Vec3::from(x_free).norm();
+            assert!(
+                (Vec3::from(fp.r()) - Vec3::from(nw.r())).norm() <= 1e-8 * scale,
+                "case {i}"
+            );
         }
         // Condition number 10: the fixed point needs ~κ·ln(1/tol) iterations.
         assert!(worst <= 400, "worst {worst}");
@@ -2249,7 +2263,9 @@ mod tests {
         // The default solver does not depend on ρ for its answer.
         let s = solve_point(&p, [0.0; 3], 1e-10, 50);
         assert!(s.converged);
-        assert!(norm(sub(s.r(), ok.r())) <= 1e-8 * norm(ok.r()));
+        assert!(
+            (Vec3::from(s.r()) - Vec3::from(ok.r())).norm() <= 1e-8 * Vec3::from(ok.r()).norm()
+        );
     }
 
     #[test]
