@@ -1286,11 +1286,11 @@ fn stick_force(w: &Mat3, x_free: &Vec3) -> Option<Vec3> {
         return None;
     }
     let mut r = Vec3::zeros();
-    match free.as_slice() {
-        &[a] => {
+    match *free.as_slice() {
+        [a] => {
             r[a] = -x_free[a] / w[(a, a)];
         }
-        &[a, b] => {
+        [a, b] => {
             let det = w[(a, a)] * w[(b, b)] - w[(a, b)] * w[(b, a)];
             if det.is_nan() || det.abs() <= 1e-14 * big * big {
                 return None;
@@ -1415,7 +1415,7 @@ mod tests {
             for i in 0..3 {
                 for k in 0..i {
                     let d = q[i].dot(&q[k]);
-                    q[i] = q[i] - q[k] * d;
+                    q[i] -= q[k] * d;
                 }
                 let n = q[i].norm();
                 q[i] /= n;
