@@ -479,6 +479,7 @@ impl SparseCholesky {
             let stack = MemStack::new(&mut self.mem);
             llt.solve_in_place_with_conj(Conj::No, mat, par, stack);
         }
+
     }
 
     /// The scalar symbolic pattern (upper triangle).
@@ -702,10 +703,7 @@ mod tests {
     #[test]
     fn sequential_and_parallel_factors_are_identical() {
         let (p, values) = grid_matrix(14);
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(2)
-            .build()
-            .unwrap();
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
         pool.install(|| {
             let mut chol = SparseCholesky::analyse(&p, 2).unwrap();
             let mut factors = Vec::new();
@@ -715,20 +713,11 @@ mod tests {
                 chol.factorise(&values).unwrap();
                 factors.push(chol.l_values.clone());
             }
-            assert!(
-                modes[..2 * PAR_TRIALS].iter().any(|&s| s),
-                "a sequential trial"
-            );
-            assert!(
-                modes[..2 * PAR_TRIALS].iter().any(|&s| !s),
-                "a parallel trial"
-            );
+            assert!(modes[..2 * PAR_TRIALS].iter().any(|&s| s), "a sequential trial");
+            assert!(modes[..2 * PAR_TRIALS].iter().any(|&s| !s), "a parallel trial");
             assert!(matches!(chol.factorise_par, ParChoice::Fixed(_)), "settled");
             for (c, f) in factors.iter().enumerate() {
-                let same = f
-                    .iter()
-                    .zip(&factors[0])
-                    .all(|(a, b)| a.to_bits() == b.to_bits());
+                let same = f.iter().zip(&factors[0]).all(|(a, b)| a.to_bits() == b.to_bits());
                 assert!(same, "factor {c} differs from the first");
             }
         });
