@@ -33,6 +33,7 @@
 pub use super::anisotropic::Orthotropy;
 use super::anisotropic::{scale, scale_matrix, unscale, unscale_matrix};
 use super::history::{HistoryField, LawHistory, NodeHistory};
+use crate::{Mat3, Vec3};
 use std::f64::consts::PI;
 
 /// Default bond cut-off ε of the RCC law: below it a bond is broken.
@@ -50,8 +51,15 @@ const MAX_TURN: f64 = 0.5;
 /// Largest number of step halvings in a line search.
 const MAX_HALVINGS: usize = 40;
 
-type V3 = [f64; 3];
-type M3 = [[f64; 3]; 3];
+/// A row-major 3×3 array as a matrix.
+fn mat3(a: [[f64; 3]; 3]) -> Mat3 {
+    Mat3::from_fn(|i, j| a[i][j])
+}
+
+/// A matrix as a row-major 3×3 array.
+fn rows(m: &Mat3) -> [[f64; 3]; 3] {
+    std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)]))
+}
 
 /// RCC adhesion parameters of a contact pair, per unit area.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -328,7 +336,7 @@ pub fn accumulated_damage(damage0: f64, beta0: f64, beta1: f64, p: &RccParams) -
 /// `μ = 0` is frictionless contact: `r_t = 0`, `r_n = max(r*_n, 0)`.
 pub fn dry_projection(r_star: [f64; 3], mu: f64) -> ([f64; 3], ContactState) {
     let mu = mu.max(0.0);
-    let st = norm2(r_star[0], r_star[1]);
+    let st = r_star[0].hypot(r_star[1]);
     let sn = r_star[2];
     if mu * st < -sn {
         return ([0.0; 3], ContactState::Apart);
@@ -350,7 +358,7 @@ pub fn dry_projection(r_star: [f64; 3], mu: f64) -> ([f64; 3], ContactState) {
 /// dry force `r_dry` [N], the local relative displacement `x` [m] and ρ [N/m].
 pub fn bipotential_trial(r_dry: [f64; 3], x: [f64; 3], mu: f64, rho: f64) -> [f64; 3] {
     let mu = mu.max(0.0);
-    let xt = norm2(x[0], x[1]);
+    let xt = x[0].hypot(x[1]);
     [
         r_dry[0] - rho * x[0],
         r_dry[1] - rho * x[1],
@@ -361,8 +369,8 @@ pub fn bipotential_trial(r_dry: [f64; 3], x: [f64; 3], mu: f64, rho: f64) -> [f6
 /// D = ∂x̂/∂x of the modified relative displacement x̂ = x + μ‖x_t‖n at `x` [m] with the
 /// friction coefficient `mu` ≥ 0: I + μ n (x_t/‖x_t‖, 0)ᵀ, the second term dropped at x_t = 0.
 pub fn modified_displacement_jacobian(x: [f64; 3], mu: f64) -> [[f64; 3]; 3] {
-    let mut d = identity();
-    let xt = norm2(x[0], x[1]);
+    let mut d = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let xt = x[0].hypot(x[1]);
     if xt > 0.0 && mu > 0.0 {
         d[2][0] = mu * x[0] / xt;
         d[2][1] = mu * x[1] / xt;
@@ -401,7 +409,8 @@ pub fn adhesive_force(beta: f64, p: &RccParams, xn: f64, ut: [f64; 2], area: f64
 /// 0 < ρ < 2/λ_max; 1/λ_max is safely inside. (1/max W_ii can reach 3/λ_max and diverge.)
 /// Falls back to 1/max|W_ii|, then 1, for degenerate blocks.
 pub fn default_rho(w_aa: [[f64; 3]; 3]) -> f64 {
-    let lmax = eig_sym3(sym(w_aa))[2];
+    let w = mat3(w_aa);
+    let lmax = eig_sym3(&((w + w.transpose()) * 0.5))[2];
     if lmax.is_finite() && lmax > 0.0 {
         return 1.0 / lmax;
     }
@@ -458,7 +467,7 @@ pub struct PointSolution {
 impl PointSolution {
     /// Total contact force r = r̄ + r̃ [N].
     pub fn r(&self) -> [f64; 3] {
-        add(self.r_dry, self.r_adh)
+        (Vec3::from(self.r_dry) + Vec3::from(self.r_adh)).into()
     }
 
     /// Whether an adhesive bond is present (β > 0).
@@ -506,22 +515,22 @@ pub fn solve_point(
 #[derive(Clone, Copy, Debug)]
 struct Eval {
     /// Dry force r̄ at which this was evaluated [N].
-    r_dry: V3,
+    r_dry: Vec3,
     /// Local relative displacement [m].
-    x: V3,
+    x: Vec3,
     /// Adhesive force r̃ [N] with x = x_free + W (r̄ + r̃) exactly; equal to the law's r̃(x) to
     /// the sub-problem's tolerance.
-    r_adh: V3,
+    r_adh: Vec3,
     /// Adhesive state at x.
     adh: AdhEval,
     /// Trial force r* [N].
-    r_star: V3,
+    r_star: Vec3,
     /// Projection of r* [N].
-    proj: V3,
+    proj: Vec3,
     /// Case of the projection.
     case: ContactState,
     /// Fixed-point defect F = r̄ − Proj(r*) [N].
-    f: V3,
+    f: Vec3,
 }
 
 /// An adhesive law evaluated at one x ([`Interface::adhesion_at`]).
@@ -532,9 +541,9 @@ pub struct AdhEval {
     /// Bond stretch u_t0 + x_t [m].
     pub ut: [f64; 2],
     /// Adhesive force r̃ [N].
-    pub force: V3,
+    pub force: Vec3,
     /// −∂r̃/∂x [N/m] (symmetric).
-    pub stiff: M3,
+    pub stiff: Mat3,
     /// Incremental interface potential φ(x) [J], with ∂φ/∂x = −r̃.
     pub energy: f64,
 }
@@ -542,6 +551,10 @@ pub struct AdhEval {
 /// Per-solve constants.
 struct Ctx<'a> {
     p: &'a PointProblem<'a>,
+    /// The problem's Delassus block W_αα [m/N].
+    w: Mat3,
+    /// The problem's x_free [m].
+    x_free: Vec3,
     /// Scale of the second tangential axis of the solver's variables (1, or μ₂/μ₁ on an
     /// orthotropic interface); the adhesive law is evaluated in the unscaled ones.
     t2: f64,
@@ -570,7 +583,7 @@ enum Method {
 /// problem of its scaled variables r' = T⁻¹r, x' = Tx ([`super::anisotropic`]).
 fn solve_point_impl(
     p: &PointProblem,
-    r_start: V3,
+    r_start: [f64; 3],
     tol: f64,
     max_iter: usize,
     method: Method,
@@ -602,7 +615,7 @@ fn solve_point_impl(
 /// (x' = T x, r' = T⁻¹ r, T = diag(1, t2, 1)); `p.law` is isotropic there.
 fn solve_scaled(
     p: &PointProblem,
-    r_start: V3,
+    r_start: [f64; 3],
     tol: f64,
     max_iter: usize,
     method: Method,
@@ -619,7 +632,9 @@ fn solve_scaled(
     } else {
         default_rho(p.w_aa)
     };
-    let scale = rho * norm(p.x_free) + adh_scale;
+    let w = mat3(p.w_aa);
+    let x_free = Vec3::from(p.x_free);
+    let scale = rho * x_free.norm() + adh_scale;
     let tol = if tol.is_finite() && tol > 0.0 {
         tol
     } else {
@@ -627,6 +642,8 @@ fn solve_scaled(
     };
     let ctx = Ctx {
         p,
+        w,
+        x_free,
         t2,
         mu,
         rho,
@@ -635,9 +652,9 @@ fn solve_scaled(
         tol_in: (1e-3 * tol).max(1e-13),
     };
     let r0 = if r_start.iter().all(|v| v.is_finite()) {
-        r_start
+        Vec3::from(r_start)
     } else {
-        [0.0; 3]
+        Vec3::zeros()
     };
     let mut used = 0;
     let newton = match method {
@@ -655,7 +672,7 @@ fn solve_scaled(
 
 /// Whether `ev` satisfies the law: fixed-point defect ‖F‖ ≤ tol·(‖r‖ + s).
 fn is_solution(ctx: &Ctx, ev: &Eval) -> bool {
-    norm(ev.f) <= ctx.tol * (norm(add(ev.r_dry, ev.r_adh)) + ctx.scale)
+    ev.f.norm() <= ctx.tol * ((ev.r_dry + ev.r_adh).norm() + ctx.scale)
 }
 
 /// Packs an evaluation into a [`PointSolution`].
@@ -666,9 +683,9 @@ fn finish(ev: &Eval, state: ContactState, iterations: usize, converged: bool) ->
         [0.0; 2]
     };
     PointSolution {
-        r_dry: ev.r_dry,
-        r_adh: ev.r_adh,
-        x: ev.x,
+        r_dry: ev.r_dry.into(),
+        r_adh: ev.r_adh.into(),
+        x: ev.x.into(),
         beta: ev.adh.beta,
         ut,
         state,
@@ -681,25 +698,25 @@ fn finish(ev: &Eval, state: ContactState, iterations: usize, converged: bool) ->
 /// apart (r̄ = 0, the adhesive sub-problem alone, valid when x_n ≥ 0), stick (x = 0, so
 /// r̄ = −W⁻¹x_free − r̃(0), valid when r̄ ∈ K_μ), slide (Newton's method on the slide equations).
 /// `Err` carries the iterations spent.
-fn solve_by_cases(ctx: &Ctx, r_start: V3, max_iter: usize) -> Result<PointSolution, usize> {
+fn solve_by_cases(ctx: &Ctx, r_start: Vec3, max_iter: usize) -> Result<PointSolution, usize> {
     let p = ctx.p;
     if max_iter == 0 {
         return Err(0);
     }
     // Apart.
-    let ev = evaluate(ctx, [0.0; 3], frozen_adhesion_guess(ctx, p.x_free));
+    let ev = evaluate(ctx, Vec3::zeros(), frozen_adhesion_guess(ctx, ctx.x_free));
     if ev.x[2] >= 0.0 && is_solution(ctx, &ev) {
         return Ok(finish(&ev, ContactState::Apart, 1, true));
     }
     // Stick.
     let r_adh0 = if p.law.is_adhesive() {
-        adhesion_eval(ctx, [0.0; 3]).force
+        adhesion_eval(ctx, Vec3::zeros()).force
     } else {
-        [0.0; 3]
+        Vec3::zeros()
     };
-    let r_stick = stick_force(p.w_aa, p.x_free).map(|r| sub(r, r_adh0));
+    let r_stick = stick_force(&ctx.w, &ctx.x_free).map(|r| r - r_adh0);
     if let Some(rs) = r_stick {
-        if rs[2] >= 0.0 && norm2(rs[0], rs[1]) <= ctx.mu * rs[2] {
+        if rs[2] >= 0.0 && rs[0].hypot(rs[1]) <= ctx.mu * rs[2] {
             let ev = evaluate(ctx, rs, r_adh0);
             if is_solution(ctx, &ev) {
                 return Ok(finish(&ev, ContactState::Stick, 2, true));
@@ -723,41 +740,29 @@ fn solve_by_cases(ctx: &Ctx, r_start: V3, max_iter: usize) -> Result<PointSoluti
 /// Slide equations in the unknowns (r_n, θ, λ): r̄ = r_n (μ cos θ, μ sin θ, 1) on the cone,
 /// slip x_t = −λ (cos θ, sin θ) opposing the friction force, x_n = 0:
 /// R = x_free + W (r̄ + r̃(x)) − x = 0. Returns R [m], ∂R/∂(r_n, θ, λ), r̄ and r̃.
-fn slide_residual(ctx: &Ctx, q: V3) -> (V3, M3, V3, V3) {
+fn slide_residual(ctx: &Ctx, q: Vec3) -> (Vec3, Mat3, Vec3, Vec3) {
     let p = ctx.p;
     let (rn, th, lam) = (q[0], q[1], q[2]);
     let c = [th.cos(), th.sin()];
     let cp = [-c[1], c[0]];
     let mu = ctx.mu;
-    let x = [-lam * c[0], -lam * c[1], 0.0];
-    let rd = [mu * rn * c[0], mu * rn * c[1], rn];
+    let x = Vec3::new(-lam * c[0], -lam * c[1], 0.0);
+    let rd = Vec3::new(mu * rn * c[0], mu * rn * c[1], rn);
     let (ra, k) = if p.law.is_adhesive() {
         let ad = adhesion_eval(ctx, x);
         (ad.force, ad.stiff)
     } else {
-        ([0.0; 3], [[0.0; 3]; 3])
+        (Vec3::zeros(), Mat3::zeros())
     };
-    let w = p.w_aa;
-    let res = sub(add(p.x_free, matvec(w, add(rd, ra))), x);
+    let w = ctx.w;
+    let res = ctx.x_free + w * (rd + ra) - x;
     // ∂R/∂x = −(I + W K) on the tangential columns.
-    let mut a = identity();
-    let wk = matmul(w, k);
-    for i in 0..3 {
-        for j in 0..3 {
-            a[i][j] += wk[i][j];
-        }
-    }
-    let d_rn = matvec(w, [mu * c[0], mu * c[1], 1.0]);
-    let d_lam = matvec(a, [c[0], c[1], 0.0]);
-    let d_th = add(
-        matvec(w, [mu * rn * cp[0], mu * rn * cp[1], 0.0]),
-        matvec(a, [lam * cp[0], lam * cp[1], 0.0]),
-    );
-    let jac = [
-        [d_rn[0], d_th[0], d_lam[0]],
-        [d_rn[1], d_th[1], d_lam[1]],
-        [d_rn[2], d_th[2], d_lam[2]],
-    ];
+    let a = Mat3::identity() + w * k;
+    let d_rn = w * Vec3::new(mu * c[0], mu * c[1], 1.0);
+    let d_lam = a * Vec3::new(c[0], c[1], 0.0);
+    let d_th = w * Vec3::new(mu * rn * cp[0], mu * rn * cp[1], 0.0)
+        + a * Vec3::new(lam * cp[0], lam * cp[1], 0.0);
+    let jac = Mat3::from_columns(&[d_rn, d_th, d_lam]);
     (res, jac, rd, ra)
 }
 
@@ -766,14 +771,14 @@ fn slide_residual(ctx: &Ctx, q: V3) -> (V3, M3, V3, V3) {
 /// stick force. Returns the evaluation at the converged dry force and the iterations spent.
 fn solve_slide(
     ctx: &Ctx,
-    r_start: V3,
-    r_stick: Option<V3>,
-    r_adh0: V3,
+    r_start: Vec3,
+    r_stick: Option<Vec3>,
+    r_adh0: Vec3,
     max_iter: usize,
 ) -> (Option<Eval>, usize) {
     let mu = ctx.mu;
-    let on_cone = |r: V3| {
-        let t = norm2(r[0], r[1]);
+    let on_cone = |r: Vec3| {
+        let t = r[0].hypot(r[1]);
         r[2] > 0.0 && t > 0.0 && (t - mu * r[2]).abs() <= 1e-6 * t
     };
     let base = if on_cone(r_start) {
@@ -781,28 +786,28 @@ fn solve_slide(
     } else {
         match r_stick {
             Some(rs) => {
-                let (pr, _) = dry_projection(rs, mu);
-                if norm2(pr[0], pr[1]) > 0.0 {
-                    pr
+                let (pr, _) = dry_projection(rs.into(), mu);
+                if pr[0].hypot(pr[1]) > 0.0 {
+                    Vec3::from(pr)
                 } else {
-                    [rs[0], rs[1], pr[2]]
+                    Vec3::new(rs[0], rs[1], pr[2])
                 }
             }
             None => r_start,
         }
     };
-    let th0 = if norm2(base[0], base[1]) > 0.0 {
+    let th0 = if base[0].hypot(base[1]) > 0.0 {
         base[1].atan2(base[0])
     } else {
         0.0
     };
-    let mut q = [base[2].max(0.0), th0, 0.0];
+    let mut q = Vec3::new(base[2].max(0.0), th0, 0.0);
     let (mut res, mut jac, mut rd, mut ra) = slide_residual(ctx, q);
     // At the first friction direction, (r_n, λ) by least squares on the linearised equations.
-    if let Some((dn, dl)) = least_squares_2(jac, res) {
-        let q1 = [q[0] + dn, q[1], (q[2] + dl).max(0.0)];
+    if let Some((dn, dl)) = least_squares_2(&jac, &res) {
+        let q1 = Vec3::new(q[0] + dn, q[1], (q[2] + dl).max(0.0));
         let trial = slide_residual(ctx, q1);
-        if norm(trial.0) < norm(res) {
+        if trial.0.norm() < res.norm() {
             q = q1;
             (res, jac, rd, ra) = trial;
         }
@@ -811,22 +816,22 @@ fn solve_slide(
     let mut converged = false;
     while iterations < max_iter {
         iterations += 1;
-        let mut d = match solve3(jac, neg(res)) {
+        let mut d = match solve3(&jac, &-res) {
             Some(d) if d.iter().all(|v| v.is_finite()) => d,
             _ => break,
         };
         if d[1].abs() > MAX_TURN {
-            let k = MAX_TURN / d[1].abs();
-            d = [k * d[0], k * d[1], k * d[2]];
+            d *= MAX_TURN / d[1].abs();
         }
-        let r_old = add(rd, ra);
-        let m0 = norm(res);
+        let r_old = rd + ra;
+        let m0 = res.norm();
         let mut alpha = 1.0;
         let mut accepted = false;
         for _ in 0..SLIDE_HALVINGS {
-            let qt = axpy(q, alpha, d);
+            let qt = q + d * alpha;
             let trial = slide_residual(ctx, qt);
-            if norm(trial.0) <= (1.0 - 1e-4 * alpha) * m0 || norm(trial.0) == 0.0 {
+            let m1 = trial.0.norm();
+            if m1 <= (1.0 - 1e-4 * alpha) * m0 || m1 == 0.0 {
                 q = qt;
                 (res, jac, rd, ra) = trial;
                 accepted = true;
@@ -836,12 +841,12 @@ fn solve_slide(
         }
         if !accepted {
             // No further decrease possible: converged if the residual is already negligible.
-            converged = ctx.rho * m0 <= ctx.tol * (norm(r_old) + ctx.scale);
+            converged = ctx.rho * m0 <= ctx.tol * (r_old.norm() + ctx.scale);
             break;
         }
-        let r_new = add(rd, ra);
-        let bound = ctx.tol * (norm(r_new) + ctx.scale);
-        if norm(sub(r_new, r_old)) <= bound && ctx.rho * norm(res) <= bound {
+        let r_new = rd + ra;
+        let bound = ctx.tol * (r_new.norm() + ctx.scale);
+        if (r_new - r_old).norm() <= bound && ctx.rho * res.norm() <= bound {
             converged = true;
             break;
         }
@@ -849,17 +854,17 @@ fn solve_slide(
     if !converged {
         return (None, iterations);
     }
-    let guess = if ra == [0.0; 3] { r_adh0 } else { ra };
+    let guess = if ra == Vec3::zeros() { r_adh0 } else { ra };
     (Some(evaluate(ctx, rd, guess)), iterations)
 }
 
 /// Least-squares solution (a, b) of a·J[:,0] + b·J[:,2] = −res (the r_n and λ columns of the
 /// slide Jacobian).
-fn least_squares_2(jac: M3, res: V3) -> Option<(f64, f64)> {
-    let c0 = [jac[0][0], jac[1][0], jac[2][0]];
-    let c2 = [jac[0][2], jac[1][2], jac[2][2]];
-    let (a11, a12, a22) = (dot(c0, c0), dot(c0, c2), dot(c2, c2));
-    let (b1, b2) = (-dot(c0, res), -dot(c2, res));
+fn least_squares_2(jac: &Mat3, res: &Vec3) -> Option<(f64, f64)> {
+    let c0 = jac.column(0);
+    let c2 = jac.column(2);
+    let (a11, a12, a22) = (c0.dot(&c0), c0.dot(&c2), c2.dot(&c2));
+    let (b1, b2) = (-c0.dot(res), -c2.dot(res));
     let det = a11 * a22 - a12 * a12;
     if !(det.is_finite() && det > 1e-14 * a11 * a22) {
         return None;
@@ -872,28 +877,27 @@ fn least_squares_2(jac: M3, res: V3) -> Option<(f64, f64)> {
 /// they reduce ‖F‖. `offset` iterations were already spent.
 fn bipotential_iteration(
     ctx: &Ctx,
-    r0: V3,
+    r0: Vec3,
     max_iter: usize,
     newton: bool,
     offset: usize,
 ) -> PointSolution {
-    let p = ctx.p;
-    let z0 = frozen_adhesion_guess(ctx, add(p.x_free, matvec(p.w_aa, r0)));
+    let z0 = frozen_adhesion_guess(ctx, ctx.x_free + ctx.w * r0);
     let mut ev = evaluate(ctx, r0, z0);
     let mut iterations = 0;
     let mut converged = false;
     while iterations < max_iter {
         iterations += 1;
-        let r_old = add(ev.r_dry, ev.r_adh);
-        let fn_old = norm(ev.f);
+        let r_old = ev.r_dry + ev.r_adh;
+        let fn_old = ev.f.norm();
         let mut next = None;
         if newton {
             if let Some(step) = newton_step(ctx, &ev) {
                 let mut alpha = 1.0;
                 for _ in 0..NEWTON_HALVINGS {
-                    let trial = dry_projection(axpy(ev.r_dry, alpha, step), ctx.mu).0;
-                    let cand = evaluate(ctx, trial, ev.r_adh);
-                    if norm(cand.f) < (1.0 - 1e-4 * alpha) * fn_old {
+                    let trial = dry_projection((ev.r_dry + step * alpha).into(), ctx.mu).0;
+                    let cand = evaluate(ctx, Vec3::from(trial), ev.r_adh);
+                    if cand.f.norm() < (1.0 - 1e-4 * alpha) * fn_old {
                         next = Some(cand);
                         break;
                     }
@@ -905,9 +909,9 @@ fn bipotential_iteration(
             Some(cand) => cand,
             None => evaluate(ctx, ev.proj, ev.r_adh),
         };
-        let r_new = add(ev.r_dry, ev.r_adh);
-        let bound = ctx.tol * (norm(r_new) + ctx.scale);
-        if norm(sub(r_new, r_old)) <= bound && norm(ev.f) <= bound {
+        let r_new = ev.r_dry + ev.r_adh;
+        let bound = ctx.tol * (r_new.norm() + ctx.scale);
+        if (r_new - r_old).norm() <= bound && ev.f.norm() <= bound {
             converged = true;
             break;
         }
@@ -919,16 +923,16 @@ fn bipotential_iteration(
 
 /// Evaluates x, the adhesive part and the projection at the dry force `r_dry`, solving the
 /// adhesive sub-problem from the adhesive-force guess `z_start`.
-fn evaluate(ctx: &Ctx, r_dry: V3, z_start: V3) -> Eval {
-    let p = ctx.p;
-    let y = add(p.x_free, matvec(p.w_aa, r_dry));
-    let (x, r_adh, adh) = if p.law.is_adhesive() {
+fn evaluate(ctx: &Ctx, r_dry: Vec3, z_start: Vec3) -> Eval {
+    let y = ctx.x_free + ctx.w * r_dry;
+    let (x, r_adh, adh) = if ctx.p.law.is_adhesive() {
         solve_adhesion(ctx, y, z_start)
     } else {
-        (y, [0.0; 3], AdhEval::default())
+        (y, Vec3::zeros(), AdhEval::default())
     };
-    let r_star = bipotential_trial(r_dry, x, ctx.mu, ctx.rho);
-    let (proj, case) = dry_projection(r_star, ctx.mu);
+    let r_star = Vec3::from(bipotential_trial(r_dry.into(), x.into(), ctx.mu, ctx.rho));
+    let (proj, case) = dry_projection(r_star.into(), ctx.mu);
+    let proj = Vec3::from(proj);
     Eval {
         r_dry,
         x,
@@ -937,7 +941,7 @@ fn evaluate(ctx: &Ctx, r_dry: V3, z_start: V3) -> Eval {
         r_star,
         proj,
         case,
-        f: sub(r_dry, proj),
+        f: r_dry - proj,
     }
 }
 
@@ -989,15 +993,17 @@ fn beta_step(beta0: f64, dt: f64, p: &RccParams, e: f64) -> (f64, f64) {
 /// The adhesive law at x: β₁, u_t, r̃, −∂r̃/∂x and the incremental potential
 /// φ = A [½ E β₁² − w β₁ + b/(2Δt) (β₁ − β₀)²] (β₁ minimises the bracket over [0, 1], so
 /// ∂φ/∂x = A β₁² ∂E/∂x / 2 = −r̃).
-fn adhesion_eval(ctx: &Ctx, x: V3) -> AdhEval {
+fn adhesion_eval(ctx: &Ctx, x: Vec3) -> AdhEval {
     let (p, s) = (ctx.p, ctx.t2);
     if s == 1.0 {
-        return p.law.adhesion_at(&p.bond0, p.dt, p.area, x);
+        return p.law.adhesion_at(&p.bond0, p.dt, p.area, x.into());
     }
     // x is scaled (x' = T x): the law at T⁻¹x', its force as T⁻¹r̃ and stiffness T⁻¹KT⁻¹.
-    let mut ev = p.law.adhesion_at(&p.bond0, p.dt, p.area, unscale(x, s));
-    ev.force = unscale(ev.force, s);
-    ev.stiff = unscale_matrix(ev.stiff, s);
+    let mut ev = p
+        .law
+        .adhesion_at(&p.bond0, p.dt, p.area, unscale(x.into(), s));
+    ev.force = Vec3::from(unscale(ev.force.into(), s));
+    ev.stiff = mat3(unscale_matrix(rows(&ev.stiff), s));
     ev
 }
 
@@ -1008,13 +1014,13 @@ pub(super) fn rcc_adhesion_at(
     dt: f64,
     area: f64,
     a: &RccParams,
-    x: V3,
+    x: [f64; 3],
 ) -> AdhEval {
     let a = &a.degraded(bond0.damage);
     let ut = [bond0.ut[0] + x[0], bond0.ut[1] + x[1]];
     let e = stretch_energy(a, x[2], ut);
     let (beta, c) = beta_step(bond0.beta, dt, a, e);
-    let force = adhesive_force(beta, a, x[2], ut, area);
+    let force = Vec3::from(adhesive_force(beta, a, x[2], ut, area));
     let xp = x[2].max(0.0);
     let mut energy = 0.5 * e * beta * beta - a.w.max(0.0) * beta;
     if a.b > 0.0 && dt > 0.0 {
@@ -1022,19 +1028,18 @@ pub(super) fn rcc_adhesion_at(
         energy += 0.5 * a.b / dt * d * d;
     }
     energy *= area;
-    let mut stiff = [[0.0; 3]; 3];
-    if beta > 0.0 {
+    let stiff = if beta > 0.0 {
         let k = area * beta * beta;
         let v = [a.ct * ut[0], a.ct2 * ut[1], a.cn * xp];
         let dn = if x[2] > 0.0 { a.cn } else { 0.0 };
         let diag = [a.ct, a.ct2, dn];
-        for i in 0..3 {
-            for j in 0..3 {
-                let d = if i == j { diag[i] } else { 0.0 };
-                stiff[i][j] = k * (d - 4.0 * c * v[i] * v[j]);
-            }
-        }
-    }
+        Mat3::from_fn(|i, j| {
+            let d = if i == j { diag[i] } else { 0.0 };
+            k * (d - 4.0 * c * v[i] * v[j])
+        })
+    } else {
+        Mat3::zeros()
+    };
     AdhEval {
         beta,
         ut,
@@ -1081,7 +1086,7 @@ pub fn adhesive_response(
     AdhesiveResponse {
         beta: ev.beta,
         ut: if ev.beta > 0.0 { ev.ut } else { [0.0; 2] },
-        force: ev.force,
+        force: ev.force.into(),
         secant_stiffness,
         energy: ev.energy,
     }
@@ -1089,34 +1094,29 @@ pub fn adhesive_response(
 
 /// Adhesive force guess with β frozen at β₀ (linear springs), given y = x_free + W r̄:
 /// z = −K₀ (y + e + W z), K₀ = A β₀² diag(C_t, C_t, C_n [y_n > 0]), e = (u_t0, 0).
-fn frozen_adhesion_guess(ctx: &Ctx, y: V3) -> V3 {
+fn frozen_adhesion_guess(ctx: &Ctx, y: Vec3) -> Vec3 {
     let (p, s) = (ctx.p, ctx.t2);
     if !p.law.is_adhesive() {
-        return [0.0; 3];
+        return Vec3::zeros();
     }
     let Some(FrozenSprings {
         stiffness: c,
         stretch: e,
     }) = p.law.frozen_springs(&p.bond0, p.area)
     else {
-        return [0.0; 3];
+        return Vec3::zeros();
     };
     // In scaled variables the springs are T⁻¹KT⁻¹ and the stretch T e.
-    let kd = [c[0], c[1] / (s * s), if y[2] > 0.0 { c[2] } else { 0.0 }];
-    let rhs = [
+    let kd = Vec3::new(c[0], c[1] / (s * s), if y[2] > 0.0 { c[2] } else { 0.0 });
+    let rhs = Vec3::new(
         -kd[0] * (y[0] + e[0]),
         -kd[1] * (y[1] + s * e[1]),
         -kd[2] * y[2],
-    ];
-    let mut m = identity();
-    for (i, row) in m.iter_mut().enumerate() {
-        for (v, wij) in row.iter_mut().zip(p.w_aa[i]) {
-            *v += kd[i] * wij;
-        }
-    }
-    match solve3(m, rhs) {
+    );
+    let m = Mat3::identity() + Mat3::from_diagonal(&kd) * ctx.w;
+    match solve3(&m, &rhs) {
         Some(z) if z.iter().all(|v| v.is_finite()) => z,
-        _ => [0.0; 3],
+        _ => Vec3::zeros(),
     }
 }
 
@@ -1124,52 +1124,42 @@ fn frozen_adhesion_guess(ctx: &Ctx, y: V3) -> V3 {
 /// Π(z) = ½ zᵀW z + φ(y + W z), whose stationary points are the solutions; the line search keeps
 /// Π decreasing, so the iteration settles in a local minimum (a stable equilibrium) next to the
 /// starting guess and, past a snap-off, slides down to the detached branch.
-fn solve_adhesion(ctx: &Ctx, y: V3, z_start: V3) -> (V3, V3, AdhEval) {
-    let p = ctx.p;
-    let w = p.w_aa;
+fn solve_adhesion(ctx: &Ctx, y: Vec3, z_start: Vec3) -> (Vec3, Vec3, AdhEval) {
+    let w = ctx.w;
     let mut z = if z_start.iter().all(|v| v.is_finite()) {
         z_start
     } else {
-        [0.0; 3]
+        Vec3::zeros()
     };
-    let mut x = add(y, matvec(w, z));
+    let mut x = y + w * z;
     let mut ad = adhesion_eval(ctx, x);
     for _ in 0..MAX_INNER {
-        let res = sub(z, ad.force);
-        let size = norm(z) + norm(ad.force) + ctx.scale;
-        if norm(res) <= ctx.tol_in * size {
+        let res = z - ad.force;
+        let size = z.norm() + ad.force.norm() + ctx.scale;
+        if res.norm() <= ctx.tol_in * size {
             break;
         }
-        let grad = matvec(w, res);
+        let grad = w * res;
         let mut dir = None;
-        let mut m = identity();
-        let kw = matmul(ad.stiff, w);
-        for i in 0..3 {
-            for j in 0..3 {
-                m[i][j] += kw[i][j];
-            }
-        }
-        if let Some(d) = solve3(m, neg(res)) {
-            if dot(grad, d) <= 0.0 && d.iter().all(|v| v.is_finite()) {
+        let m = Mat3::identity() + ad.stiff * w;
+        if let Some(d) = solve3(&m, &-res) {
+            if grad.dot(&d) <= 0.0 && d.iter().all(|v| v.is_finite()) {
                 dir = Some(d);
             }
         }
         let d = match dir {
             Some(d) => d,
-            None => match shifted_newton_direction(w, ad.stiff, grad) {
-                Some(d) => d,
-                None => neg(res),
-            },
+            None => shifted_newton_direction(&w, &ad.stiff, &grad).unwrap_or(-res),
         };
-        let pi0 = merit(z, w, ad.energy);
-        let slope = dot(grad, d);
+        let pi0 = merit(&z, &w, ad.energy);
+        let slope = grad.dot(&d);
         let mut alpha = 1.0;
         let mut accepted = None;
         for _ in 0..MAX_HALVINGS {
-            let zt = axpy(z, alpha, d);
-            let xt = add(y, matvec(w, zt));
+            let zt = z + d * alpha;
+            let xt = y + w * zt;
             let at = adhesion_eval(ctx, xt);
-            let pit = merit(zt, w, at.energy);
+            let pit = merit(&zt, &w, at.energy);
             let slack = 1e-13 * (pi0.abs() + pit.abs());
             if pit <= pi0 + 1e-4 * alpha * slope + slack {
                 accepted = Some((zt, xt, at));
@@ -1178,15 +1168,15 @@ fn solve_adhesion(ctx: &Ctx, y: V3, z_start: V3) -> (V3, V3, AdhEval) {
             alpha *= 0.5;
         }
         let (zn, xn, an) = accepted.unwrap_or_else(|| {
-            let zt = add(z, d);
-            let xt = add(y, matvec(w, zt));
+            let zt = z + d;
+            let xt = y + w * zt;
             (zt, xt, adhesion_eval(ctx, xt))
         });
-        let moved = norm(sub(zn, z));
+        let moved = (zn - z).norm();
         z = zn;
         x = xn;
         ad = an;
-        if moved <= 1e-15 * (norm(z) + ctx.scale) {
+        if moved <= 1e-15 * (z.norm() + ctx.scale) {
             break;
         }
     }
@@ -1194,66 +1184,46 @@ fn solve_adhesion(ctx: &Ctx, y: V3, z_start: V3) -> (V3, V3, AdhEval) {
 }
 
 /// Π(z) = ½ zᵀ W z + φ [J].
-fn merit(z: V3, w: M3, energy: f64) -> f64 {
-    0.5 * dot(z, matvec(w, z)) + energy
+fn merit(z: &Vec3, w: &Mat3, energy: f64) -> f64 {
+    0.5 * z.dot(&(w * z)) + energy
 }
 
 /// Descent direction from the Hessian of Π in z, H = W + W K W, shifted to be positive definite
 /// when the interface softens.
-fn shifted_newton_direction(w: M3, k: M3, grad: V3) -> Option<V3> {
-    let h = sym(add_m(w, matmul(w, matmul(k, w))));
-    let ev = eig_sym3(h);
+fn shifted_newton_direction(w: &Mat3, k: &Mat3, grad: &Vec3) -> Option<Vec3> {
+    let h = w + w * (k * w);
+    let h = (h + h.transpose()) * 0.5;
+    let ev = eig_sym3(&h);
     let big = ev[0].abs().max(ev[2].abs());
     if !(big.is_finite() && big > 0.0) {
         return None;
     }
     let shift = (-ev[0]).max(0.0) + 1e-6 * big;
-    let mut hs = h;
-    for (i, row) in hs.iter_mut().enumerate() {
-        row[i] += shift;
-    }
-    solve3(hs, neg(grad)).filter(|d| d.iter().all(|v| v.is_finite()))
+    let hs = h + Mat3::from_diagonal_element(shift);
+    solve3(&hs, &-grad).filter(|d| d.iter().all(|v| v.is_finite()))
 }
 
 /// Semi-smooth Newton step on F(r̄) = r̄ − Proj(r̄ − ρ g(x(r̄))), g(x) = x + μ‖x_t‖n:
 /// ∂F/∂r̄ = I − P′ (I − ρ G W_e), with P′ the Jacobian of the projection in its case,
 /// G = ∂g/∂x and W_e = (I + W K)⁻¹ W the compliance seen by r̄ with the adhesive part solved.
-fn newton_step(ctx: &Ctx, ev: &Eval) -> Option<V3> {
-    let p = ctx.p;
-    let mut m = identity();
-    let wk = matmul(p.w_aa, ev.adh.stiff);
-    for i in 0..3 {
-        for j in 0..3 {
-            m[i][j] += wk[i][j];
-        }
-    }
-    let we = solve3_mat(m, p.w_aa)?;
-    let gw = matmul(modified_displacement_jacobian(ev.x, ctx.mu), we);
-    let mut a = identity();
-    for i in 0..3 {
-        for j in 0..3 {
-            a[i][j] -= ctx.rho * gw[i][j];
-        }
-    }
-    let pj = projection_jacobian(ev.r_star, ctx.mu, ev.case);
-    let pa = matmul(pj, a);
-    let mut jac = identity();
-    for i in 0..3 {
-        for j in 0..3 {
-            jac[i][j] -= pa[i][j];
-        }
-    }
-    solve3(jac, neg(ev.f)).filter(|d| d.iter().all(|v| v.is_finite()))
+fn newton_step(ctx: &Ctx, ev: &Eval) -> Option<Vec3> {
+    let m = Mat3::identity() + ctx.w * ev.adh.stiff;
+    let we = solve3_mat(&m, &ctx.w)?;
+    let gw = mat3(modified_displacement_jacobian(ev.x.into(), ctx.mu)) * we;
+    let a = Mat3::identity() - gw * ctx.rho;
+    let pj = mat3(projection_jacobian(ev.r_star.into(), ctx.mu, ev.case));
+    let jac = Mat3::identity() - pj * a;
+    solve3(&jac, &-ev.f).filter(|d| d.iter().all(|v| v.is_finite()))
 }
 
 /// Jacobian of [`dry_projection`] at `r_star` in the given case (symmetric, eigenvalues in
 /// [0, 1]).
-pub fn projection_jacobian(r_star: V3, mu: f64, case: ContactState) -> M3 {
+pub fn projection_jacobian(r_star: [f64; 3], mu: f64, case: ContactState) -> [[f64; 3]; 3] {
     match case {
         ContactState::Apart => [[0.0; 3]; 3],
-        ContactState::Stick => identity(),
+        ContactState::Stick => [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
         ContactState::Slide => {
-            let s = norm2(r_star[0], r_star[1]);
+            let s = r_star[0].hypot(r_star[1]);
             let q = 1.0 + mu * mu;
             if s.is_nan() || s <= 0.0 {
                 let mut j = [[0.0; 3]; 3];
@@ -1278,7 +1248,7 @@ pub fn projection_jacobian(r_star: V3, mu: f64, case: ContactState) -> M3 {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Small dense helpers on [f64; 3] and [[f64; 3]; 3].
+// Small dense helpers.
 
 pub(super) fn clamp01(v: f64) -> f64 {
     if v > 1.0 {
@@ -1290,109 +1260,43 @@ pub(super) fn clamp01(v: f64) -> f64 {
     }
 }
 
-fn norm2(a: f64, b: f64) -> f64 {
-    a.hypot(b)
-}
-
-fn norm(v: V3) -> f64 {
-    dot(v, v).sqrt()
-}
-
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn neg(a: V3) -> V3 {
-    [-a[0], -a[1], -a[2]]
-}
-
-fn axpy(a: V3, s: f64, b: V3) -> V3 {
-    [a[0] + s * b[0], a[1] + s * b[1], a[2] + s * b[2]]
-}
-
-fn identity() -> M3 {
-    [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
-}
-
-fn matvec(m: M3, v: V3) -> V3 {
-    [dot(m[0], v), dot(m[1], v), dot(m[2], v)]
-}
-
-fn matmul(a: M3, b: M3) -> M3 {
-    let mut c = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            c[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j];
-        }
-    }
-    c
-}
-
-fn add_m(a: M3, b: M3) -> M3 {
-    let mut c = a;
-    for i in 0..3 {
-        for j in 0..3 {
-            c[i][j] += b[i][j];
-        }
-    }
-    c
-}
-
-fn sym(a: M3) -> M3 {
-    let mut s = a;
-    for i in 0..3 {
-        for j in 0..3 {
-            s[i][j] = 0.5 * (a[i][j] + a[j][i]);
-        }
-    }
-    s
-}
-
 /// The total force r with W r = −x_free (the point stuck: x = 0). Where the compliance W has
 /// a local axis along which no force moves the point (a diagonal entry negligible against the
 /// largest, e.g. the out-of-plane tangent of a plane-strain model, whose unknowns are held),
 /// the force has no component along it (the least-norm solution) provided x_free has none
 /// either; the other components solve the remaining rows. None when no such force exists.
-fn stick_force(w: M3, x_free: V3) -> Option<V3> {
-    if let Some(r) = solve3(w, neg(x_free)) {
+fn stick_force(w: &Mat3, x_free: &Vec3) -> Option<Vec3> {
+    if let Some(r) = solve3(w, &-x_free) {
         return Some(r);
     }
-    let big = w.iter().flatten().fold(0.0_f64, |acc, v| acc.max(v.abs()));
+    let big = w.iter().fold(0.0_f64, |acc, v| acc.max(v.abs()));
     if !(big.is_finite() && big > 0.0) {
         return None;
     }
     // W is symmetric positive semi-definite: a negligible diagonal entry bounds its whole row
     // and column (|W_ij| ≤ √(W_ii W_jj)).
-    let null: Vec<bool> = (0..3).map(|i| w[i][i].abs() <= 1e-12 * big).collect();
+    let null: [bool; 3] = std::array::from_fn(|i| w[(i, i)].abs() <= 1e-12 * big);
     let free: Vec<usize> = (0..3).filter(|&i| !null[i]).collect();
     if free.len() == 3 || free.is_empty() {
         return None;
     }
     // A direction the force cannot move must already be at rest.
-    let scale = norm(x_free);
+    let scale = x_free.norm();
     if (0..3).any(|i| null[i] && x_free[i].abs() > 1e-9 * scale) {
         return None;
     }
-    let mut r = [0.0; 3];
-    match free.as_slice() {
-        &[a] => {
-            r[a] = -x_free[a] / w[a][a];
+    let mut r = Vec3::zeros();
+    match *free.as_slice() {
+        [a] => {
+            r[a] = -x_free[a] / w[(a, a)];
         }
-        &[a, b] => {
-            let det = w[a][a] * w[b][b] - w[a][b] * w[b][a];
+        [a, b] => {
+            let det = w[(a, a)] * w[(b, b)] - w[(a, b)] * w[(b, a)];
             if det.is_nan() || det.abs() <= 1e-14 * big * big {
                 return None;
             }
-            r[a] = (-x_free[a] * w[b][b] + x_free[b] * w[a][b]) / det;
-            r[b] = (-x_free[b] * w[a][a] + x_free[a] * w[b][a]) / det;
+            r[a] = (-x_free[a] * w[(b, b)] + x_free[b] * w[(a, b)]) / det;
+            r[b] = (-x_free[b] * w[(a, a)] + x_free[a] * w[(b, a)]) / det;
         }
         _ => return None,
     }
@@ -1400,91 +1304,87 @@ fn stick_force(w: M3, x_free: V3) -> Option<V3> {
 }
 
 /// Solves m x = b by Gaussian elimination with partial pivoting; `None` when m is singular to
-/// working precision.
-fn solve3(m: M3, b: V3) -> Option<V3> {
-    let mut a = m;
-    let mut r = b;
-    let big = a
-        .iter()
-        .flat_map(|row| row.iter())
-        .fold(0.0_f64, |acc, v| acc.max(v.abs()));
+/// working precision (a pivot at most 1e-14 times the largest entry of m).
+fn solve3(m: &Mat3, b: &Vec3) -> Option<Vec3> {
+    let mut a = *m;
+    let mut r = *b;
+    let big = a.iter().fold(0.0_f64, |acc, v| acc.max(v.abs()));
     if !(big.is_finite() && big > 0.0) {
         return None;
     }
     for col in 0..3 {
         let mut piv = col;
         for row in col + 1..3 {
-            if a[row][col].abs() > a[piv][col].abs() {
+            if a[(row, col)].abs() > a[(piv, col)].abs() {
                 piv = row;
             }
         }
-        let pivot = a[piv][col].abs();
+        let pivot = a[(piv, col)].abs();
         if pivot.is_nan() || pivot <= 1e-14 * big {
             return None;
         }
-        a.swap(col, piv);
-        r.swap(col, piv);
+        if piv != col {
+            a.swap_rows(col, piv);
+            r.swap_rows(col, piv);
+        }
         for row in col + 1..3 {
-            let f = a[row][col] / a[col][col];
-            let pivot_row = a[col];
-            for (v, pv) in a[row].iter_mut().zip(pivot_row).skip(col) {
-                *v -= f * pv;
+            let f = a[(row, col)] / a[(col, col)];
+            for k in col..3 {
+                a[(row, k)] -= f * a[(col, k)];
             }
             r[row] -= f * r[col];
         }
     }
-    let mut x = [0.0; 3];
+    let mut x = Vec3::zeros();
     for i in (0..3).rev() {
         let mut s = r[i];
         for k in i + 1..3 {
-            s -= a[i][k] * x[k];
+            s -= a[(i, k)] * x[k];
         }
-        x[i] = s / a[i][i];
+        x[i] = s / a[(i, i)];
     }
     Some(x)
 }
 
 /// Solves m X = b column by column.
-fn solve3_mat(m: M3, b: M3) -> Option<M3> {
-    let mut out = [[0.0; 3]; 3];
+fn solve3_mat(m: &Mat3, b: &Mat3) -> Option<Mat3> {
+    let mut out = Mat3::zeros();
     for j in 0..3 {
-        let col = solve3(m, [b[0][j], b[1][j], b[2][j]])?;
-        for i in 0..3 {
-            out[i][j] = col[i];
-        }
+        let col = solve3(m, &b.column(j).into_owned())?;
+        out.set_column(j, &col);
     }
     Some(out)
 }
 
 /// Eigenvalues of a symmetric 3×3 matrix in ascending order (trigonometric closed form).
-fn eig_sym3(a: M3) -> V3 {
-    let p1 = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
-    let q = (a[0][0] + a[1][1] + a[2][2]) / 3.0;
-    let d = [a[0][0] - q, a[1][1] - q, a[2][2] - q];
+fn eig_sym3(a: &Mat3) -> Vec3 {
+    let p1 = a[(0, 1)] * a[(0, 1)] + a[(0, 2)] * a[(0, 2)] + a[(1, 2)] * a[(1, 2)];
+    let q = (a[(0, 0)] + a[(1, 1)] + a[(2, 2)]) / 3.0;
+    let d = [a[(0, 0)] - q, a[(1, 1)] - q, a[(2, 2)] - q];
     let p2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + 2.0 * p1;
     let p = (p2 / 6.0).sqrt();
     if p.is_nan() || p <= 0.0 {
-        return [q, q, q];
+        return Vec3::repeat(q);
     }
-    let mut b = a;
-    for (i, row) in b.iter_mut().enumerate() {
-        for (j, v) in row.iter_mut().enumerate() {
-            *v = (*v - if i == j { q } else { 0.0 }) / p;
-        }
-    }
-    let det = b[0][0] * (b[1][1] * b[2][2] - b[1][2] * b[2][1])
-        - b[0][1] * (b[1][0] * b[2][2] - b[1][2] * b[2][0])
-        + b[0][2] * (b[1][0] * b[2][1] - b[1][1] * b[2][0]);
+    let b = (a - Mat3::from_diagonal_element(q)) / p;
+    let det = b[(0, 0)] * (b[(1, 1)] * b[(2, 2)] - b[(1, 2)] * b[(2, 1)])
+        - b[(0, 1)] * (b[(1, 0)] * b[(2, 2)] - b[(1, 2)] * b[(2, 0)])
+        + b[(0, 2)] * (b[(1, 0)] * b[(2, 1)] - b[(1, 1)] * b[(2, 0)]);
     let phi = (0.5 * det).clamp(-1.0, 1.0).acos() / 3.0;
     let l_hi = q + 2.0 * p * phi.cos();
     let l_lo = q + 2.0 * p * (phi + 2.0 * PI / 3.0).cos();
     let l_mid = 3.0 * q - l_hi - l_lo;
-    [l_lo, l_mid, l_hi]
+    Vec3::new(l_lo, l_mid, l_hi)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A force or displacement in local components, as the public functions take it.
+    type V3 = [f64; 3];
+    /// A 3×3 block in rows, as the public functions take it.
+    type M3 = [[f64; 3]; 3];
 
     /// Deterministic generator for randomised tests (splitmix64).
     struct Rng(u64);
@@ -1505,7 +1405,7 @@ mod tests {
 
         /// Random symmetric positive definite matrix with eigenvalues in [lo, hi].
         fn spd(&mut self, lo: f64, hi: f64) -> M3 {
-            let mut q = [[0.0; 3]; 3];
+            let mut q = [Vec3::zeros(); 3];
             for row in q.iter_mut() {
                 for v in row.iter_mut() {
                     *v = self.uniform(-1.0, 1.0);
@@ -1514,11 +1414,11 @@ mod tests {
             // Gram-Schmidt on the rows.
             for i in 0..3 {
                 for k in 0..i {
-                    let d = dot(q[i], q[k]);
-                    q[i] = axpy(q[i], -d, q[k]);
+                    let d = q[i].dot(&q[k]);
+                    q[i] -= q[k] * d;
                 }
-                let n = norm(q[i]);
-                q[i] = [q[i][0] / n, q[i][1] / n, q[i][2] / n];
+                let n = q[i].norm();
+                q[i] /= n;
             }
             let l = [lo, self.uniform(lo, hi), hi];
             let mut m = [[0.0; 3]; 3];
@@ -1540,8 +1440,9 @@ mod tests {
     }
 
     fn assert_vec_close(a: V3, b: V3, tol: f64) {
-        let s = norm(a).max(norm(b)).max(f64::MIN_POSITIVE);
-        assert!(norm(sub(a, b)) <= tol * s, "{a:?} vs {b:?} (tol {tol})");
+        let (va, vb) = (Vec3::from(a), Vec3::from(b));
+        let s = va.norm().max(vb.norm()).max(f64::MIN_POSITIVE);
+        assert!((va - vb).norm() <= tol * s, "{a:?} vs {b:?} (tol {tol})");
     }
 
     const DRY: InterfaceLaw = InterfaceLaw {
@@ -1570,21 +1471,22 @@ mod tests {
     /// Independent check of a point solution against the laws of docs/model.md §5: x = x_free + W r,
     /// r̄ ∈ K_μ, Signorini complementarity, Coulomb sliding rule, and the RCC part.
     fn check_solution(p: &PointProblem, s: &PointSolution, tol: f64) {
-        let r = s.r();
-        let x = add(p.x_free, matvec(p.w_aa, r));
-        let xs = norm(p.x_free).max(norm(x)).max(f64::MIN_POSITIVE);
-        let parts = xs + norm(matvec(p.w_aa, s.r_dry)) + norm(matvec(p.w_aa, s.r_adh));
+        let r = Vec3::from(s.r());
+        let (w, x_free) = (mat3(p.w_aa), Vec3::from(p.x_free));
+        let x = x_free + w * r;
+        let xs = x_free.norm().max(x.norm()).max(f64::MIN_POSITIVE);
+        let parts = xs + (w * Vec3::from(s.r_dry)).norm() + (w * Vec3::from(s.r_adh)).norm();
         assert!(
-            norm(sub(x, s.x)) <= 1e-12 * parts,
+            (x - Vec3::from(s.x)).norm() <= 1e-12 * parts,
             "x = x_free + W r: {x:?} vs {:?} ({s:?}, {p:?})",
             s.x
         );
         let mu = p.law.mu;
-        let fs = norm(r) + p.rho * norm(p.x_free);
+        let fs = r.norm() + p.rho * x_free.norm();
         let rd = s.r_dry;
         assert!(rd[2] >= 0.0, "dry normal force is compressive");
-        assert!(norm2(rd[0], rd[1]) <= mu * rd[2] * (1.0 + 1e-12) + 1e-300);
-        let xt = norm2(x[0], x[1]);
+        assert!(rd[0].hypot(rd[1]) <= mu * rd[2] * (1.0 + 1e-12) + 1e-300);
+        let xt = x[0].hypot(x[1]);
         match s.state {
             ContactState::Apart => {
                 assert_eq!(rd, [0.0; 3]);
@@ -1596,7 +1498,7 @@ mod tests {
             }
             ContactState::Slide => {
                 assert!(x[2].abs() <= tol * xs, "slide gap {}", x[2]);
-                let rt = norm2(rd[0], rd[1]);
+                let rt = rd[0].hypot(rd[1]);
                 assert!((rt - mu * rd[2]).abs() <= tol * fs, "on the cone");
                 if rt > tol * fs && xt > tol * xs {
                     let c = (rd[0] * x[0] + rd[1] * x[1]) / (rt * xt);
@@ -1611,9 +1513,9 @@ mod tests {
                 let beta = beta_update(p.bond0.beta, p.dt, a, x[2], ut);
                 assert!((beta - s.beta).abs() <= 1e-9, "β {beta} vs {}", s.beta);
                 let ra = adhesive_force(beta, a, x[2], ut, p.area);
-                let scale = norm(ra) + p.area * a.peak_traction();
+                let scale = Vec3::from(ra).norm() + p.area * a.peak_traction();
                 assert!(
-                    norm(sub(ra, s.r_adh)) <= tol * scale,
+                    (Vec3::from(ra) - Vec3::from(s.r_adh)).norm() <= tol * scale,
                     "{ra:?} vs {:?}",
                     s.r_adh
                 );
@@ -1665,12 +1567,13 @@ mod tests {
         let rs = [1.5, -2.0, 0.4];
         let (r, c) = dry_projection(rs, mu);
         assert_eq!(c, ContactState::Slide);
-        let st = norm2(rs[0], rs[1]);
+        let st = rs[0].hypot(rs[1]);
         let t = [rs[0] / st, rs[1] / st];
         let k = (st - mu * rs[2]) / (1.0 + mu * mu);
-        assert_vec_close(sub(rs, r), [k * t[0], k * t[1], -k * mu], 1e-14);
+        let y = Vec3::from(rs) - Vec3::from(r);
+        assert_vec_close(y.into(), [k * t[0], k * t[1], -k * mu], 1e-14);
         let gen = [mu * t[0], mu * t[1], 1.0];
-        assert!(dot(sub(rs, r), gen).abs() <= 1e-14 * norm(rs));
+        assert!(y.dot(&Vec3::from(gen)).abs() <= 1e-14 * Vec3::from(rs).norm());
         let rn = r[2];
         assert_vec_close(r, [rn * gen[0], rn * gen[1], rn * gen[2]], 1e-14);
     }
@@ -1683,7 +1586,7 @@ mod tests {
         let printed = [rs[0] - k, rs[1], rs[2] - k * mu];
         assert!(printed[2] < 0.0, "printed sign gives r_n = {}", printed[2]);
         let (ours, _) = dry_projection(rs, mu);
-        assert!(ours[2] > 0.0 && (norm2(ours[0], ours[1]) - mu * ours[2]).abs() < 1e-15);
+        assert!(ours[2] > 0.0 && (ours[0].hypot(ours[1]) - mu * ours[2]).abs() < 1e-15);
     }
 
     #[test]
@@ -1704,32 +1607,35 @@ mod tests {
             ];
             let (r, c) = dry_projection(rs, mu);
             hits[c as usize] += 1;
-            let s = norm(rs);
+            let s = Vec3::from(rs).norm();
             let tol = 1e-12 * s;
             // In the cone.
             assert!(r[2] >= 0.0);
-            assert!(norm2(r[0], r[1]) <= mu * r[2] + tol, "{rs:?} μ={mu}");
+            assert!(r[0].hypot(r[1]) <= mu * r[2] + tol, "{rs:?} μ={mu}");
             // Idempotent.
             let (rr, cc) = dry_projection(r, mu);
-            assert!(norm(sub(rr, r)) <= tol, "idempotence {rs:?} μ={mu}");
-            if norm(r) > 0.0 {
+            assert!(
+                (Vec3::from(rr) - Vec3::from(r)).norm() <= tol,
+                "idempotence {rs:?} μ={mu}"
+            );
+            if Vec3::from(r).norm() > 0.0 {
                 assert_ne!(cc, ContactState::Apart);
             }
             // Moreau: y = r* − r lies in the polar cone {μ‖y_t‖ ≤ −y_n} and y ⊥ r.
-            let y = sub(rs, r);
-            assert!(mu * norm2(y[0], y[1]) + y[2] <= tol, "polar {rs:?} μ={mu}");
+            let y = Vec3::from(rs) - Vec3::from(r);
+            assert!(mu * y[0].hypot(y[1]) + y[2] <= tol, "polar {rs:?} μ={mu}");
             assert!(
-                dot(y, r).abs() <= 1e-12 * s * s,
+                y.dot(&Vec3::from(r)).abs() <= 1e-12 * s * s,
                 "orthogonality {rs:?} μ={mu}"
             );
             // Nearest point: no random point of the cone is closer.
-            let d = norm(y);
+            let d = y.norm();
             for _ in 0..4 {
                 let kn = mag * rng.uniform(0.0, 2.0);
                 let ang = rng.uniform(0.0, 2.0 * PI);
                 let kt = mu * kn * rng.uniform(0.0, 1.0);
                 let k = [kt * ang.cos(), kt * ang.sin(), kn];
-                assert!(norm(sub(rs, k)) >= d - tol);
+                assert!((Vec3::from(rs) - Vec3::from(k)).norm() >= d - tol);
             }
         }
         assert!(hits.iter().all(|&h| h > 1000), "all cases hit: {hits:?}");
@@ -2049,7 +1955,7 @@ mod tests {
         for _ in 0..1000 {
             let hi = 10f64.powf(rng.uniform(-6.9, -3.0));
             let w = rng.spd(1e-7, hi);
-            let ev = eig_sym3(w);
+            let ev = eig_sym3(&mat3(w));
             let hi = w
                 .iter()
                 .map(|r| r.iter().map(|v| v.abs()).sum::<f64>())
@@ -2080,7 +1986,7 @@ mod tests {
         let s = solve_point(&p, [0.0; 3], 1e-12, 50);
         assert!(s.converged);
         assert_eq!(s.state, ContactState::Stick);
-        assert!(norm2(s.x[0], s.x[1]) <= 1e-12 * 1e-4);
+        assert!(s.x[0].hypot(s.x[1]) <= 1e-12 * 1e-4);
         assert_vec_close(s.r(), [-10.0, 0.0, 50.0], 1e-10);
         check_solution(&p, &s, 1e-10);
         // Slide: the sticking force would be 50 N > 15 N.
@@ -2309,8 +2215,11 @@ mod tests {
             let nw = solve_point(&p, [0.0; 3], 1e-10, 50);
             assert!(nw.converged);
             assert_eq!(fp.state, nw.state, "case {i}");
-            let scale = norm(fp.r()) + p.rho * norm(x_free);
-            assert!(norm(sub(fp.r(), nw.r())) <= 1e-8 * scale, "case {i}");
+            let scale = Vec3::from(fp.r()).norm() + p.rho * Vec3::from(x_free).norm();
+            assert!(
+                (Vec3::from(fp.r()) - Vec3::from(nw.r())).norm() <= 1e-8 * scale,
+                "case {i}"
+            );
         }
         // Condition number 10: the fixed point needs ~κ·ln(1/tol) iterations.
         assert!(worst <= 400, "worst {worst}");
@@ -2354,7 +2263,9 @@ mod tests {
         // The default solver does not depend on ρ for its answer.
         let s = solve_point(&p, [0.0; 3], 1e-10, 50);
         assert!(s.converged);
-        assert!(norm(sub(s.r(), ok.r())) <= 1e-8 * norm(ok.r()));
+        assert!(
+            (Vec3::from(s.r()) - Vec3::from(ok.r())).norm() <= 1e-8 * Vec3::from(ok.r()).norm()
+        );
     }
 
     #[test]

@@ -14,6 +14,7 @@ use super::law::{
     BondState, FrozenSprings, Interface, InterfaceLaw, PairScales, PointSolution,
 };
 use crate::warnings::{cohesive_zone_length, CN_STIFFNESS_RATIO};
+use crate::Vec3;
 
 /// The history of the RCC law at a slave node, between steps.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -74,10 +75,6 @@ impl From<&NodeHistory> for RccHistory {
     fn from(h: &NodeHistory) -> Self {
         RccHistory::decode(h)
     }
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 impl Interface for InterfaceLaw {
@@ -153,7 +150,10 @@ impl Interface for InterfaceLaw {
         let h = RccHistory::decode(node);
         BondState {
             beta: h.beta,
-            ut: [dot(h.ut, frame[0]), dot(h.ut, frame[1])],
+            ut: [
+                Vec3::from(h.ut).dot(&Vec3::from(frame[0])),
+                Vec3::from(h.ut).dot(&Vec3::from(frame[1])),
+            ],
             damage: h.damage,
         }
     }
