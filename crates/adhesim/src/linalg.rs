@@ -306,12 +306,12 @@ const PAR_TRIALS: usize = 3;
 ///
 /// faer's parallel supernodal factorisation pays off on a bulky 3D block factorised alone
 /// (`bench_core --sizes 20,30 --threads 1,2`: 0.81× and 0.69× the sequential time on 2
-/// threads) but not always inside a run, where
-/// thin bodies have narrow elimination trees and the pool's threads are woken for every
-/// call: the 3,136-node pad took 1.24× and the 4.4 twist 1.27× its sequential time with 2
-/// /// threads (docs/running.md, *Threads*). The two modes give bit-identical factors (the test
-/// below, and the histories of both runs), so timing the first calls of each, alternating,
-/// and keeping the faster for the rest has no effect on the results.
+/// threads) but not always inside a run, where thin bodies have narrow elimination trees and
+/// the pool's threads are woken for every call: the 3,136-node pad took 1.24× and the 4.4
+/// twist 1.27× their sequential time with 2 threads (docs/running.md, *Threads*). The two
+/// modes give bit-identical factors (the test below, and the histories of both runs), so
+/// timing the first calls of each, alternating, and keeping the faster for the rest has no
+/// effect on the results.
 #[derive(Clone, Debug)]
 enum ParChoice {
     /// Settled (or only one thread).
