@@ -150,25 +150,26 @@ impl Checkpoint {
                 self.version
             )));
         }
-        if self.fingerprint != fingerprint(problem) && self.format != FORMAT {
-            // The fingerprint hashes the problem as this build describes it, and the builds
-            // that wrote the older format described the same scenario differently.
-            return Err(mismatch(format!(
-                "it was written in checkpoint format {} by an earlier build of adhesim \
-                 {version}, whose description of a scenario differs from this build's even \
-                 when the scenario file is the same; finish the run with the build that \
-                 started it, or start it again (this build resumes checkpoints of format \
-                 {FORMAT})",
-                self.format
-            )));
-        }
         if self.fingerprint != fingerprint(problem) {
-            return Err(mismatch(
+            // The fingerprint hashes the problem as this build describes it; the builds that
+            // wrote an older format described the same scenario differently, so a mismatch
+            // there says nothing about the scenario.
+            let reason = if self.format != FORMAT {
+                format!(
+                    "it was written in checkpoint format {} by an earlier build of adhesim \
+                     {version}, whose description of a scenario differs from this build's \
+                     even when the scenario file is the same; finish the run with the build \
+                     that started it, or start it again (this build resumes checkpoints of \
+                     format {FORMAT})",
+                    self.format
+                )
+            } else {
                 "the scenario differs from the one the run was started with (meshes, \
                  materials, loads, contact, time stepping, tracks or output settings changed); \
                  resume with the unchanged scenario, or start a new run in another directory"
-                    .into(),
-            ));
+                    .into()
+            };
+            return Err(mismatch(reason));
         }
         Ok(())
     }

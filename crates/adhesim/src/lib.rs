@@ -35,5 +35,16 @@ pub mod warnings;
 pub type Mat3 = nalgebra::Matrix3<f64>;
 /// 3-vector of f64 (positions, displacements, forces).
 pub type Vec3 = nalgebra::Vector3<f64>;
+/// A row-major 3×3 array (rows t₁, t₂, n of a contact frame, a point's W block) as a
+/// [`Mat3`]; nalgebra's own `From` reads such an array as columns.
+pub fn mat3_from_rows(a: [[f64; 3]; 3]) -> Mat3 {
+    Mat3::from_fn(|i, j| a[i][j])
+}
+
+/// A [`Mat3`] as a row-major 3×3 array, the inverse of [`mat3_from_rows`].
+pub fn rows_of(m: &Mat3) -> [[f64; 3]; 3] {
+    std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)]))
+}
+
 /// 6×6 matrix of f64 (material tangents in Voigt notation).
 pub type Mat6 = nalgebra::Matrix6<f64>;

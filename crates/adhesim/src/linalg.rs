@@ -488,6 +488,18 @@ impl SparseCholesky {
     }
 }
 
+/// When [`gmres`] stops: at a true residual ‖b − A x‖ ≤ `tol` ‖b‖, or after `max_iter`
+/// iterations; it restarts every `restart` iterations.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KrylovLimits {
+    /// Relative tolerance on the residual [-].
+    pub tol: f64,
+    /// Iteration limit.
+    pub max_iter: usize,
+    /// Iterations between restarts.
+    pub restart: usize,
+}
+
 /// What [`gmres`] reached.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct KrylovOutcome {
@@ -503,19 +515,16 @@ pub fn norm(x: &[f64]) -> f64 {
 }
 
 /// Restarted GMRES with right preconditioning for A x = b, from x = 0: `apply(v, out)` sets
-/// out = A v, `precondition(v)` overwrites v with M⁻¹ v. Stops when the true residual
-/// ‖b − A x‖ ≤ `tol` ‖b‖ or after `max_iter` iterations (restarts every `restart`). Right
+/// out = A v, `precondition(v)` overwrites v with M⁻¹ v; it stops as `limits` say. Right
 /// preconditioning keeps the residual it monitors that of the original system.
 pub fn gmres(
     apply: impl Fn(&[f64], &mut [f64]),
     precondition: impl FnMut(&mut [f64]),
     b: &[f64],
-    tol: f64,
-    max_iter: usize,
-    restart: usize,
+    limits: KrylovLimits,
 ) -> (Vec<f64>, KrylovOutcome) {
     let krylov = |_: &[f64], z: &[f64], w: &mut [f64]| apply(z, w);
-    gmres_core(&apply, krylov, precondition, b, tol, max_iter, restart)
+    gmres_core(&apply, krylov, precondition, b, limits)
 }
 
 /// [`gmres`] for A = M + E with M the preconditioner's own matrix (M⁻¹ solved exactly, up to
@@ -528,9 +537,7 @@ pub fn gmres_with_remainder(
     remainder: impl Fn(&[f64], &mut [f64]),
     precondition: impl FnMut(&mut [f64]),
     b: &[f64],
-    tol: f64,
-    max_iter: usize,
-    restart: usize,
+    limits: KrylovLimits,
 ) -> (Vec<f64>, KrylovOutcome) {
     let krylov = |v: &[f64], z: &[f64], w: &mut [f64]| {
         remainder(z, w);
@@ -538,7 +545,7 @@ pub fn gmres_with_remainder(
             *wi += vi;
         }
     };
-    gmres_core(&apply, krylov, precondition, b, tol, max_iter, restart)
+    gmres_core(&apply, krylov, precondition, b, limits)
 }
 
 /// Restarted right-preconditioned GMRES: `krylov(v, z, w)` sets w = A z for z = M⁻¹ v.
@@ -547,10 +554,13 @@ fn gmres_core(
     krylov: impl Fn(&[f64], &[f64], &mut [f64]),
     mut precondition: impl FnMut(&mut [f64]),
     b: &[f64],
-    tol: f64,
-    max_iter: usize,
-    restart: usize,
+    limits: KrylovLimits,
 ) -> (Vec<f64>, KrylovOutcome) {
+    let KrylovLimits {
+        tol,
+        max_iter,
+        restart,
+    } = limits;
     let n = b.len();
     let dot = |a: &[f64], c: &[f64]| a.iter().zip(c).map(|(x, y)| x * y).sum::<f64>();
     let b_norm = dot(b, b).sqrt();
@@ -835,6 +845,11 @@ mod tests {
     /// solved exactly) needs fewer iterations than none.
     #[test]
     fn gmres_solves_an_unsymmetric_system() {
+        const LIMITS: KrylovLimits = KrylovLimits {
+            tol: 1e-12,
+            max_iter: 400,
+            restart: 30,
+        };
         let n = 40;
         let mut a = nalgebra::DMatrix::<f64>::zeros(n, n);
         for i in 0..n {
@@ -856,7 +871,7 @@ mod tests {
             let y = &a * nalgebra::DVector::from_column_slice(v);
             out.copy_from_slice(y.as_slice());
         };
-        let (x, plain) = gmres(apply, |_| {}, &b, 1e-12, 400, 30);
+        let (x, plain) = gmres(apply, |_| {}, &b, LIMITS);
         assert!(plain.relative_residual <= 1e-12, "{plain:?}");
         for (xi, ei) in x.iter().zip(exact.iter()) {
             assert!((xi - ei).abs() < 1e-10 * exact.norm(), "{xi} vs {ei}");
@@ -868,7 +883,7 @@ mod tests {
                 .unwrap();
             v.copy_from_slice(y.as_slice());
         };
-        let (x, pre) = gmres(apply, precondition, &b, 1e-12, 400, 30);
+        let (x, pre) = gmres(apply, precondition, &b, LIMITS);
         assert!(pre.relative_residual <= 1e-12, "{pre:?}");
         assert!(pre.iterations < plain.iterations, "{pre:?} vs {plain:?}");
         for (xi, ei) in x.iter().zip(exact.iter()) {
@@ -882,7 +897,7 @@ mod tests {
             let y = &e * nalgebra::DVector::from_column_slice(v);
             out.copy_from_slice(y.as_slice());
         };
-        let (x, split) = gmres_with_remainder(apply, remainder, precondition, &b, 1e-12, 400, 30);
+        let (x, split) = gmres_with_remainder(apply, remainder, precondition, &b, LIMITS);
         assert!(split.relative_residual <= 1e-12, "{split:?}");
         assert!(
             split.iterations <= pre.iterations + 1,

@@ -33,7 +33,7 @@
 pub use super::anisotropic::Orthotropy;
 use super::anisotropic::{scale, scale_matrix, unscale, unscale_matrix};
 use super::history::{HistoryField, LawHistory, NodeHistory};
-use crate::{Mat3, Vec3};
+use crate::{mat3_from_rows, rows_of, Mat3, Vec3};
 use std::f64::consts::PI;
 
 /// Default bond cut-off ε of the RCC law: below it a bond is broken.
@@ -50,16 +50,6 @@ const SLIDE_HALVINGS: usize = 6;
 const MAX_TURN: f64 = 0.5;
 /// Largest number of step halvings in a line search.
 const MAX_HALVINGS: usize = 40;
-
-/// A row-major 3×3 array as a matrix.
-fn mat3(a: [[f64; 3]; 3]) -> Mat3 {
-    Mat3::from_fn(|i, j| a[i][j])
-}
-
-/// A matrix as a row-major 3×3 array.
-fn rows(m: &Mat3) -> [[f64; 3]; 3] {
-    std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)]))
-}
 
 /// RCC adhesion parameters of a contact pair, per unit area.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -409,7 +399,7 @@ pub fn adhesive_force(beta: f64, p: &RccParams, xn: f64, ut: [f64; 2], area: f64
 /// 0 < ρ < 2/λ_max; 1/λ_max is safely inside. (1/max W_ii can reach 3/λ_max and diverge.)
 /// Falls back to 1/max|W_ii|, then 1, for degenerate blocks.
 pub fn default_rho(w_aa: [[f64; 3]; 3]) -> f64 {
-    let w = mat3(w_aa);
+    let w = mat3_from_rows(w_aa);
     let lmax = eig_sym3(&((w + w.transpose()) * 0.5))[2];
     if lmax.is_finite() && lmax > 0.0 {
         return 1.0 / lmax;
@@ -632,7 +622,7 @@ fn solve_scaled(
     } else {
         default_rho(p.w_aa)
     };
-    let w = mat3(p.w_aa);
+    let w = mat3_from_rows(p.w_aa);
     let x_free = Vec3::from(p.x_free);
     let scale = rho * x_free.norm() + adh_scale;
     let tol = if tol.is_finite() && tol > 0.0 {
@@ -1003,7 +993,7 @@ fn adhesion_eval(ctx: &Ctx, x: Vec3) -> AdhEval {
         .law
         .adhesion_at(&p.bond0, p.dt, p.area, unscale(x.into(), s));
     ev.force = Vec3::from(unscale(ev.force.into(), s));
-    ev.stiff = mat3(unscale_matrix(rows(&ev.stiff), s));
+    ev.stiff = mat3_from_rows(unscale_matrix(rows_of(&ev.stiff), s));
     ev
 }
 
@@ -1209,9 +1199,9 @@ fn shifted_newton_direction(w: &Mat3, k: &Mat3, grad: &Vec3) -> Option<Vec3> {
 fn newton_step(ctx: &Ctx, ev: &Eval) -> Option<Vec3> {
     let m = Mat3::identity() + ctx.w * ev.adh.stiff;
     let we = solve3_mat(&m, &ctx.w)?;
-    let gw = mat3(modified_displacement_jacobian(ev.x.into(), ctx.mu)) * we;
+    let gw = mat3_from_rows(modified_displacement_jacobian(ev.x.into(), ctx.mu)) * we;
     let a = Mat3::identity() - gw * ctx.rho;
-    let pj = mat3(projection_jacobian(ev.r_star.into(), ctx.mu, ev.case));
+    let pj = mat3_from_rows(projection_jacobian(ev.r_star.into(), ctx.mu, ev.case));
     let jac = Mat3::identity() - pj * a;
     solve3(&jac, &-ev.f).filter(|d| d.iter().all(|v| v.is_finite()))
 }
@@ -1472,7 +1462,7 @@ mod tests {
     /// r̄ ∈ K_μ, Signorini complementarity, Coulomb sliding rule, and the RCC part.
     fn check_solution(p: &PointProblem, s: &PointSolution, tol: f64) {
         let r = Vec3::from(s.r());
-        let (w, x_free) = (mat3(p.w_aa), Vec3::from(p.x_free));
+        let (w, x_free) = (mat3_from_rows(p.w_aa), Vec3::from(p.x_free));
         let x = x_free + w * r;
         let xs = x_free.norm().max(x.norm()).max(f64::MIN_POSITIVE);
         let parts = xs + (w * Vec3::from(s.r_dry)).norm() + (w * Vec3::from(s.r_adh)).norm();
@@ -1955,7 +1945,7 @@ mod tests {
         for _ in 0..1000 {
             let hi = 10f64.powf(rng.uniform(-6.9, -3.0));
             let w = rng.spd(1e-7, hi);
-            let ev = eig_sym3(&mat3(w));
+            let ev = eig_sym3(&mat3_from_rows(w));
             let hi = w
                 .iter()
                 .map(|r| r.iter().map(|v| v.abs()).sum::<f64>())

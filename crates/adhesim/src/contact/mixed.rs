@@ -37,7 +37,7 @@ use super::law::{
 use super::semismooth::{ARMIJO, ETA_DOWN, ETA_MAX, ETA_MIN, ETA_START, ETA_UP};
 use crate::linalg::{metis_dof_ordering, BlockPattern};
 use crate::sparse_lu::OrderedLu;
-use crate::Mat3;
+use crate::{mat3_from_rows, Mat3};
 
 type V3 = [f64; 3];
 
@@ -81,7 +81,7 @@ pub fn linearise_point(
     let mu = law.mu.max(0.0);
     let (r_adh, k_adh, beta, ut) = match law.adhesive_response(&bond0, dt, area, x) {
         Some(resp) => {
-            let k = Mat3::from_fn(|i, j| resp.secant_stiffness[i][j]);
+            let k = mat3_from_rows(resp.secant_stiffness);
             (resp.force, k, resp.beta, resp.ut)
         }
         None => ([0.0; 3], Mat3::zeros(), 0.0, [0.0; 2]),
@@ -92,9 +92,9 @@ pub fn linearise_point(
     let r_star = bipotential_trial(ys, xs, mu, rho);
     let (proj, state) = dry_projection(r_star, mu);
     let pj = projection_jacobian(r_star, mu, state);
-    let pj = Mat3::from_fn(|i, j| pj[i][j]);
+    let pj = mat3_from_rows(pj);
     let d = modified_displacement_jacobian(xs, mu);
-    let d = Mat3::from_fn(|i, j| d[i][j]);
+    let d = mat3_from_rows(d);
     let t = Mat3::from_diagonal(&scale([1.0; 3], s).into());
     let t_inv = Mat3::from_diagonal(&unscale([1.0; 3], s).into());
     let a = t * (Mat3::identity() - pj) * t_inv;

@@ -5,7 +5,7 @@
 use super::detect::ContactPoint;
 use super::law::{default_rho, solve_point, BondState, InterfaceLaw, PointProblem, PointSolution};
 use crate::linalg::LinearSolve;
-use crate::Mat3;
+use crate::{mat3_from_rows, Mat3};
 
 /// The dense Delassus operator W = H K̄⁻¹ Hᵀ of the contact points.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -103,7 +103,7 @@ impl Delassus {
     pub fn rotate_frames(&mut self, from: &[[[f64; 3]; 3]], to: &[[[f64; 3]; 3]]) {
         assert_eq!(from.len(), to.len());
         assert_eq!(3 * from.len(), self.m);
-        let mat = |f: &[[f64; 3]; 3]| Mat3::from_fn(|i, j| f[i][j]);
+        let mat = |f: &[[f64; 3]; 3]| mat3_from_rows(*f);
         // None where a point's frame is unchanged: its blocks stay bit for bit.
         let rot: Vec<Option<Mat3>> = from
             .iter()
@@ -276,7 +276,7 @@ mod tests {
     /// W in local frames from W^g in global axes: W_αβ = F_α W^g_αβ F_βᵀ.
     fn local(wg: &[f64], frames: &[[[f64; 3]; 3]]) -> Delassus {
         let m = 3 * frames.len();
-        let mat = |f: &[[f64; 3]; 3]| Mat3::from_fn(|i, j| f[i][j]);
+        let mat = |f: &[[f64; 3]; 3]| mat3_from_rows(*f);
         let mut w = vec![0.0; m * m];
         for (a, fa) in frames.iter().enumerate() {
             for (b, fb) in frames.iter().enumerate() {

@@ -19,9 +19,9 @@ use crate::contact::mixed::{
 };
 use crate::contact::newton::add_contact_tangent;
 use crate::contact::newton::RHO_FACTOR;
-use crate::linalg::gmres_with_remainder;
+use crate::linalg::{gmres_with_remainder, KrylovLimits};
 use crate::system::SystemMatrix;
-use crate::Mat3;
+use crate::{mat3_from_rows, rows_of, Mat3};
 use std::time::Instant;
 
 /// ρ_α of the natural map the Newton iterations work on, as a multiple of the stiffness K̄
@@ -268,14 +268,17 @@ impl<'a> ContactCoupling<'a> for MixedCoupling<'a> {
 /// Newton iterations still converge to the exact solution, at a rate of about this factor.
 const ETA_FLOOR: f64 = 1e-8;
 
-/// GMRES: relative tolerance, largest relative residual accepted, iteration limit, restart.
-/// Near the step's solution the stiff springs of sticking points (up to 10⁸ ρ) keep GMRES's
-/// attainable accuracy at about 1e-10, which a tolerance of 1e-10 made it chase for 200
-/// iterations; 1e-8 is reached in 5 to 8 at 10⁴ contact points.
-const GMRES_TOL: f64 = 1e-8;
+/// GMRES: relative tolerance, iteration limit, restart. Near the step's solution the stiff
+/// springs of sticking points (up to 10⁸ ρ) keep GMRES's attainable accuracy at about 1e-10,
+/// which a tolerance of 1e-10 made it chase for 200 iterations; 1e-8 is reached in 5 to 8 at
+/// 10⁴ contact points.
+const GMRES: KrylovLimits = KrylovLimits {
+    tol: 1e-8,
+    max_iter: 200,
+    restart: 40,
+};
+/// Largest relative residual of GMRES accepted as a direction.
 const GMRES_ACCEPT: f64 = 1e-6;
-const GMRES_MAX: usize = 200;
-const GMRES_RESTART: usize = 40;
 
 /// Largest mixed matrix (unknowns plus three per contact point) factorised by LU when GMRES
 /// does not converge: a sparse LU with partial pivoting of a 3D mesh fills in much more than
@@ -348,7 +351,7 @@ impl MixedDirection for CondensedDirection<'_> {
                 return Ok(None);
             };
             let p = positive_symmetric_part(&(inv_plain * l.b_plain));
-            positive.push(std::array::from_fn(|i| std::array::from_fn(|j| p[(i, j)])));
+            positive.push(rows_of(&p));
             g.push(inv * nalgebra::Vector3::from(l.phi));
             s.push(sa);
         }
@@ -372,7 +375,7 @@ impl MixedDirection for CondensedDirection<'_> {
         let rest: Vec<Mat3> = s
             .iter()
             .zip(&positive)
-            .map(|(sa, p)| sa - Mat3::from_fn(|i, j| p[i][j]))
+            .map(|(sa, p)| sa - mat3_from_rows(*p))
             .collect();
         let h = self.h;
         let (pattern, values, factor) = self.system.operator_and_factor();
@@ -394,15 +397,7 @@ impl MixedDirection for CondensedDirection<'_> {
             pattern.symmetric_matvec(values, v, out);
         };
         let precondition = |v: &mut [f64]| factor.solve_in_place(v);
-        let (du, outcome) = gmres_with_remainder(
-            apply,
-            remainder,
-            precondition,
-            &rhs,
-            GMRES_TOL,
-            GMRES_MAX,
-            GMRES_RESTART,
-        );
+        let (du, outcome) = gmres_with_remainder(apply, remainder, precondition, &rhs, GMRES);
         if !(outcome.relative_residual <= GMRES_ACCEPT) {
             // GMRES stalled (strongly coupled sliding points): the exact direction from the
             // LU of the whole mixed matrix, where it fits in memory.
