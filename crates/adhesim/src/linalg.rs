@@ -227,6 +227,9 @@ impl BlockPattern {
     }
 }
 
+/// Held while METIS runs (see [`metis_dof_ordering`]).
+static METIS_LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 /// Fill-reducing ordering of the nodes by METIS nested dissection; returns (forward,
 /// inverse) permutations of the scalar unknowns, three per node.
 pub fn metis_dof_ordering(pattern: &BlockPattern) -> Result<(Vec<usize>, Vec<usize>), LinalgError> {
@@ -238,6 +241,12 @@ pub fn metis_dof_ordering(pattern: &BlockPattern) -> Result<(Vec<usize>, Vec<usi
             let mut nvtxs = n as i32;
             let mut perm = vec![0i32; n];
             let mut iperm = vec![0i32; n];
+            // METIS draws from a random-number generator whose state is one global of the
+            // C library, seeded at the start of each call: two calls from different threads
+            // (concurrent runs of a sweep, tests) interleave their draws and get different
+            // orderings, hence different round-off. One call at a time keeps every run's
+            // ordering the same.
+            let _only_caller = METIS_LOCK.lock().unwrap_or_else(|e| e.into_inner());
             // SAFETY: the arrays have the lengths METIS expects (xadj n+1, adjncy xadj[n],
             // perm and iperm n); null pointers select the default weights and options.
             let status = unsafe {
@@ -778,6 +787,31 @@ mod tests {
                     .zip(&factors[0])
                     .all(|(a, b)| a.to_bits() == b.to_bits());
                 assert!(same, "factor {c} differs from the first");
+            }
+        });
+    }
+
+    /// METIS keeps its random generator in a global: orderings computed on several threads
+    /// at once (a sweep's concurrent cases) must still be the one computed alone.
+    #[test]
+    fn concurrent_orderings_equal_the_ordering_computed_alone() {
+        let (p, _) = grid_matrix(9);
+        let alone = metis_dof_ordering(&p).unwrap();
+        std::thread::scope(|scope| {
+            let workers: Vec<_> = (0..4)
+                .map(|_| {
+                    scope.spawn(|| {
+                        (0..25)
+                            .map(|_| metis_dof_ordering(&p).unwrap())
+                            .all(|o| o == alone)
+                    })
+                })
+                .collect();
+            for w in workers {
+                assert!(
+                    w.join().unwrap(),
+                    "an ordering differs from the one computed alone"
+                );
             }
         });
     }
