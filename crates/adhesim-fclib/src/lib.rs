@@ -596,8 +596,8 @@ pub fn solve_global(
         linearise_point(&laws[c], BondState::default(), 1.0, 1.0, rho[c], r, x)
     };
     let error = |pts: &[PointSolution]| {
-        let r: Vec<[f64; 3]> = pts.iter().map(|s| s.r_dry).collect();
-        let x: Vec<[f64; 3]> = pts.iter().map(|s| s.x).collect();
+        let r: Vec<[f64; 3]> = pts.iter().map(|s| s.r_dry.into()).collect();
+        let x: Vec<[f64; 3]> = pts.iter().map(|s| s.x.into()).collect();
         relative_error(natural_map_residual(&r, &x, &p.mu), &q, &r, &x)
     };
     let op = MixedOperator {
@@ -625,7 +625,7 @@ pub fn solve_global(
         max_iter,
         &mut eta_rel,
     )?;
-    let x: Vec<[f64; 3]> = sol.points.iter().map(|s| s.x).collect();
+    let x: Vec<[f64; 3]> = sol.points.iter().map(|s| s.x.into()).collect();
     Ok(ReducedSolution {
         residual: natural_map_residual(&sol.r, &x, &p.mu),
         r: sol.r,

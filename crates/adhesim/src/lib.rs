@@ -35,6 +35,8 @@ pub mod warnings;
 pub type Mat3 = nalgebra::Matrix3<f64>;
 /// 3-vector of f64 (positions, displacements, forces).
 pub type Vec3 = nalgebra::Vector3<f64>;
+/// 2-vector of f64 (tangential components in a contact frame).
+pub type Vec2 = nalgebra::Vector2<f64>;
 /// A row-major 3×3 array (rows t₁, t₂, n of a contact frame, a point's W block) as a
 /// [`Mat3`]; nalgebra's own `From` reads such an array as columns.
 pub fn mat3_from_rows(a: [[f64; 3]; 3]) -> Mat3 {

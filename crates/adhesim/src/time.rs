@@ -545,7 +545,7 @@ impl Stepper {
         }
         for ((pt, sol), b0) in points.iter().zip(sols).zip(bond0) {
             let f = &pt.frame;
-            let r = sol.r();
+            let r: [f64; 3] = sol.r().into();
             let global = |v: [f64; 3]| -> [f64; 3] {
                 std::array::from_fn(|k| v[0] * f[0][k] + v[1] * f[1][k] + v[2] * f[2][k])
             };
@@ -554,8 +554,8 @@ impl Stepper {
             let part = |v: [f64; 3]| v.map(|c| share * c);
             let node = NodeContact {
                 history: self.problem.contacts[pt.pair].law.commit(b0, sol, f),
-                r_dry: part(sol.r_dry),
-                r_adh: part(sol.r_adh),
+                r_dry: part(sol.r_dry.into()),
+                r_adh: part(sol.r_adh.into()),
                 force: part(global(r)),
                 gap: sol.x[2],
                 slip: [sol.x[0], sol.x[1]],

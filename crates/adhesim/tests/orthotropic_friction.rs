@@ -14,6 +14,7 @@ use adhesim::contact::law::{
 };
 use adhesim::contact::newton::augmented_point;
 use adhesim::time::Stepper;
+use adhesim::{mat3_from_rows, Mat3, Vec2, Vec3};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -113,9 +114,9 @@ fn sliding_point_lands_on_the_ellipse_with_the_maximal_dissipation_direction() {
     for angle in [0.0f64, 45.0, 90.0, 30.0] {
         let a = angle.to_radians();
         // Free displacement: pressed 1 mm into the plane and pushed 10 mm along (cos, sin).
-        let x_free = [1e-2 * a.cos(), 1e-2 * a.sin(), -1e-3];
+        let x_free = Vec3::new(1e-2 * a.cos(), 1e-2 * a.sin(), -1e-3);
         let p = PointProblem {
-            w_aa: [[c, 0.0, 0.0], [0.0, c, 0.0], [0.0, 0.0, c]],
+            w_aa: Mat3::from_diagonal_element(c),
             x_free,
             law: &l,
             bond0: BondState::default(),
@@ -123,7 +124,7 @@ fn sliding_point_lands_on_the_ellipse_with_the_maximal_dissipation_direction() {
             area: 1e-6,
             rho: 1.0 / c,
         };
-        let sol = solve_point(&p, [0.0; 3], 1e-12, 100);
+        let sol = solve_point(&p, Vec3::zeros(), 1e-12, 100);
         assert!(sol.converged, "{angle}°");
         let rn = sol.r_dry[2];
         assert!((rn - 1e-3 / c).abs() < 1e-9 * rn, "{angle}°: r_n {rn}");
@@ -182,15 +183,15 @@ fn equal_coefficients_reproduce_the_isotropic_law() {
         }),
         ..iso
     };
-    let w = [[2e-6, 3e-7, 1e-7], [3e-7, 1e-6, -2e-7], [1e-7, -2e-7, 3e-6]];
+    let w = mat3_from_rows([[2e-6, 3e-7, 1e-7], [3e-7, 1e-6, -2e-7], [1e-7, -2e-7, 3e-6]]);
     for x_free in [
-        [1e-4, -3e-5, -2e-5],
-        [2e-6, 1e-6, 5e-6],
-        [1e-3, 1e-3, -1e-6],
+        Vec3::new(1e-4, -3e-5, -2e-5),
+        Vec3::new(2e-6, 1e-6, 5e-6),
+        Vec3::new(1e-3, 1e-3, -1e-6),
     ] {
         let bond0 = BondState {
             beta: 0.7,
-            ut: [1e-6, -2e-6],
+            ut: Vec2::new(1e-6, -2e-6),
             damage: 0.0,
         };
         let p = |law| PointProblem {
@@ -202,8 +203,8 @@ fn equal_coefficients_reproduce_the_isotropic_law() {
             area: 1e-6,
             rho: 0.0,
         };
-        let a = solve_point(&p(&iso), [0.0; 3], 1e-12, 200);
-        let b = solve_point(&p(&ortho), [0.0; 3], 1e-12, 200);
+        let a = solve_point(&p(&iso), Vec3::zeros(), 1e-12, 200);
+        let b = solve_point(&p(&ortho), Vec3::zeros(), 1e-12, 200);
         assert_eq!(a, b);
     }
 }
@@ -217,12 +218,12 @@ fn orthotropic_adhesion_stiffness_per_axis() {
     let area = 1e-6;
     let bond = BondState {
         beta: 1.0,
-        ut: [0.0; 2],
+        ut: Vec2::zeros(),
         damage: 0.0,
     };
     let u = 1e-7; // well inside the bond's strength: β stays 1
     for (k, ct) in [(0usize, 4e9), (1, 1e9)] {
-        let mut x = [0.0; 3];
+        let mut x = Vec3::zeros();
         x[k] = u;
         let r = adhesive_response(&rcc, bond, 1e-3, area, x);
         assert_eq!(r.beta, 1.0);
@@ -232,7 +233,7 @@ fn orthotropic_adhesion_stiffness_per_axis() {
             "axis {k}"
         );
         assert_eq!(r.force[1 - k], 0.0);
-        assert!((r.secant_stiffness[k][k] - ct * area).abs() < 1e-6);
+        assert!((r.secant_stiffness[(k, k)] - ct * area).abs() < 1e-6);
         // −∂φ/∂x_k by central differences.
         let h = 1e-10;
         let (mut xp, mut xm) = (x, x);

@@ -134,7 +134,7 @@ fn nsgs_dense(p: &ReducedProblem, del: &Delassus, tol: f64, max_iter: usize) -> 
     let mut sweeps = 0;
     while error > tol && sweeps < max_iter {
         let sol = gauss_seidel(&points, &laws, &bond0, 1.0, del, &p.q, &r, &r, 0.0, 1);
-        r = sol.points.iter().map(|s| s.r_dry).collect();
+        r = sol.points.iter().map(|s| s.r_dry.into()).collect();
         sweeps += 1;
         (residual, error) = error_of(&p.w, &p.q, &p.mu, &r, &mut x);
     }

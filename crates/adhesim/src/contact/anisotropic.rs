@@ -15,6 +15,7 @@
 //! This module is plain algebra on local vectors; the law (`law.rs`: `InterfaceLaw::
 //! tangent_scale`, `natural_map_defect`) and the detection (`detect::align_frames`) use it.
 
+use crate::{Mat3, Vec3};
 use nalgebra::Vector3;
 
 /// The material axes and second friction coefficient of an orthotropic interface.
@@ -44,25 +45,25 @@ pub fn aligned_frame(normal: [f64; 3], axis: [f64; 3]) -> Option<[[f64; 3]; 3]> 
 }
 
 /// The scaling T = diag(1, s, 1) applied to a local vector.
-pub fn scale(v: [f64; 3], s: f64) -> [f64; 3] {
-    [v[0], s * v[1], v[2]]
+pub fn scale(v: Vec3, s: f64) -> Vec3 {
+    Vec3::new(v[0], s * v[1], v[2])
 }
 
 /// T⁻¹ applied to a local vector.
-pub fn unscale(v: [f64; 3], s: f64) -> [f64; 3] {
-    [v[0], v[1] / s, v[2]]
+pub fn unscale(v: Vec3, s: f64) -> Vec3 {
+    Vec3::new(v[0], v[1] / s, v[2])
 }
 
 /// T M T for a local 3×3 matrix M (a compliance such as W).
-pub fn scale_matrix(m: [[f64; 3]; 3], s: f64) -> [[f64; 3]; 3] {
-    let t = [1.0, s, 1.0];
-    std::array::from_fn(|i| std::array::from_fn(|j| t[i] * m[i][j] * t[j]))
+pub fn scale_matrix(m: Mat3, s: f64) -> Mat3 {
+    let t = Vec3::new(1.0, s, 1.0);
+    Mat3::from_fn(|i, j| t[i] * m[(i, j)] * t[j])
 }
 
 /// T⁻¹ M T⁻¹ for a local 3×3 matrix M (a stiffness −∂r/∂x seen in the scaled variables).
-pub fn unscale_matrix(m: [[f64; 3]; 3], s: f64) -> [[f64; 3]; 3] {
-    let t = [1.0, s, 1.0];
-    std::array::from_fn(|i| std::array::from_fn(|j| m[i][j] / (t[i] * t[j])))
+pub fn unscale_matrix(m: Mat3, s: f64) -> Mat3 {
+    let t = Vec3::new(1.0, s, 1.0);
+    Mat3::from_fn(|i, j| m[(i, j)] / (t[i] * t[j]))
 }
 
 /// Friction force (t₁, t₂ components) [N] of a point sliding in the unit direction `slip` of the

@@ -33,7 +33,7 @@
 pub use super::anisotropic::Orthotropy;
 use super::anisotropic::{scale, scale_matrix, unscale, unscale_matrix};
 use super::history::{HistoryField, LawHistory, NodeHistory};
-use crate::{mat3_from_rows, rows_of, Mat3, Vec3};
+use crate::{Mat3, Vec2, Vec3};
 use std::f64::consts::PI;
 
 /// Default bond cut-off ε of the RCC law: below it a bond is broken.
@@ -182,7 +182,7 @@ pub trait Interface {
     /// [m²]: the force r̃, its tangent −∂r̃/∂x, the incremental potential and the history
     /// values the step leads to. Only called when [`Interface::is_adhesive`]; the
     /// Gauss-Seidel point solver ([`solve_point`]) solves with it.
-    fn adhesion_at(&self, start: &BondState, dt: f64, area: f64, x: [f64; 3]) -> AdhEval;
+    fn adhesion_at(&self, start: &BondState, dt: f64, area: f64, x: Vec3) -> AdhEval;
 
     /// Warm start of the point solver's adhesive sub-problem at a point whose history is frozen
     /// at `start`, with tributary area `area` [m²]: the linear springs that approximate its
@@ -204,7 +204,7 @@ pub trait Interface {
         start: &BondState,
         dt: f64,
         area: f64,
-        x: [f64; 3],
+        x: Vec3,
     ) -> Option<AdhesiveResponse>;
 
     /// The frozen history at the start of a step of a point whose node history is `node`,
@@ -225,9 +225,9 @@ pub trait Interface {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrozenSprings {
     /// Diagonal of K along t₁, t₂ and n [N/m]; the normal spring acts in tension only.
-    pub stiffness: [f64; 3],
+    pub stiffness: Vec3,
     /// Stretch e of the tangential springs at x = 0, along t₁ and t₂ [m].
-    pub stretch: [f64; 2],
+    pub stretch: Vec2,
 }
 
 /// What a law's own checks of a contact pair see ([`Interface::warnings`]).
@@ -251,7 +251,7 @@ pub const REGISTERED_HISTORIES: &[&[HistoryField]] = &[super::rcc::RccHistory::F
 /// The defect r̄ − P_K(r̄ − ρ x̂) [N] of the law's bi-potential condition at a dry force `r_dry`
 /// [N] and local relative displacement `x` [m], with `rho` [N/m]: zero exactly at a solution.
 /// For an orthotropic law it is evaluated in the scaled variables and mapped back by T.
-pub fn natural_map_defect(law: &InterfaceLaw, rho: f64, r_dry: [f64; 3], x: [f64; 3]) -> [f64; 3] {
+pub fn natural_map_defect(law: &InterfaceLaw, rho: f64, r_dry: Vec3, x: Vec3) -> Vec3 {
     let s = law.tangent_scale();
     let (r, y) = if s == 1.0 {
         (r_dry, x)
@@ -259,7 +259,7 @@ pub fn natural_map_defect(law: &InterfaceLaw, rho: f64, r_dry: [f64; 3], x: [f64
         (unscale(r_dry, s), scale(x, s))
     };
     let p = dry_projection(bipotential_trial(r, y, law.mu, rho), law.mu).0;
-    let d = [r[0] - p[0], r[1] - p[1], r[2] - p[2]];
+    let d = r - p;
     if s == 1.0 {
         d
     } else {
@@ -285,7 +285,7 @@ pub struct BondState {
     /// Intensity of adhesion β₀ ∈ [0, 1] [-].
     pub beta: f64,
     /// Accumulated stretch of the adhesive links in the (t1, t2) plane [m].
-    pub ut: [f64; 2],
+    pub ut: Vec2,
     /// Adhesive energy dissipated at the point so far, D [J/m²] ([`accumulated_damage`]).
     pub damage: f64,
 }
@@ -324,12 +324,12 @@ pub fn accumulated_damage(damage0: f64, beta0: f64, beta1: f64, p: &RccParams) -
 /// - sliding otherwise: `r_n = (r*_n + μ‖r*_t‖)/(1 + μ²)`, `r_t = μ r_n r*_t/‖r*_t‖`.
 ///
 /// `μ = 0` is frictionless contact: `r_t = 0`, `r_n = max(r*_n, 0)`.
-pub fn dry_projection(r_star: [f64; 3], mu: f64) -> ([f64; 3], ContactState) {
+pub fn dry_projection(r_star: Vec3, mu: f64) -> (Vec3, ContactState) {
     let mu = mu.max(0.0);
     let st = r_star[0].hypot(r_star[1]);
     let sn = r_star[2];
     if mu * st < -sn {
-        return ([0.0; 3], ContactState::Apart);
+        return (Vec3::zeros(), ContactState::Apart);
     }
     if st <= mu * sn {
         return (r_star, ContactState::Stick);
@@ -338,32 +338,31 @@ pub fn dry_projection(r_star: [f64; 3], mu: f64) -> ([f64; 3], ContactState) {
     let rn = ((sn + mu * st) / (1.0 + mu * mu)).max(0.0);
     if st > 0.0 {
         let k = mu * rn / st;
-        ([k * r_star[0], k * r_star[1], rn], ContactState::Slide)
+        (
+            Vec3::new(k * r_star[0], k * r_star[1], rn),
+            ContactState::Slide,
+        )
     } else {
-        ([0.0, 0.0, rn], ContactState::Slide)
+        (Vec3::new(0.0, 0.0, rn), ContactState::Slide)
     }
 }
 
 /// Bi-potential trial force r* = r̄ − ρ (x + μ‖x_t‖ n) [N] (docs/model.md §5, paper eq 30), from the
 /// dry force `r_dry` [N], the local relative displacement `x` [m] and ρ [N/m].
-pub fn bipotential_trial(r_dry: [f64; 3], x: [f64; 3], mu: f64, rho: f64) -> [f64; 3] {
+pub fn bipotential_trial(r_dry: Vec3, x: Vec3, mu: f64, rho: f64) -> Vec3 {
     let mu = mu.max(0.0);
     let xt = x[0].hypot(x[1]);
-    [
-        r_dry[0] - rho * x[0],
-        r_dry[1] - rho * x[1],
-        r_dry[2] - rho * (x[2] + mu * xt),
-    ]
+    r_dry - rho * Vec3::new(x[0], x[1], x[2] + mu * xt)
 }
 
 /// D = ∂x̂/∂x of the modified relative displacement x̂ = x + μ‖x_t‖n at `x` [m] with the
 /// friction coefficient `mu` ≥ 0: I + μ n (x_t/‖x_t‖, 0)ᵀ, the second term dropped at x_t = 0.
-pub fn modified_displacement_jacobian(x: [f64; 3], mu: f64) -> [[f64; 3]; 3] {
-    let mut d = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+pub fn modified_displacement_jacobian(x: Vec3, mu: f64) -> Mat3 {
+    let mut d = Mat3::identity();
     let xt = x[0].hypot(x[1]);
     if xt > 0.0 && mu > 0.0 {
-        d[2][0] = mu * x[0] / xt;
-        d[2][1] = mu * x[1] / xt;
+        d[(2, 0)] = mu * x[0] / xt;
+        d[(2, 1)] = mu * x[1] / xt;
     }
     d
 }
@@ -379,32 +378,35 @@ pub fn modified_displacement_jacobian(x: [f64; 3], mu: f64) -> [[f64; 3]; 3] {
 /// - `dt ≤ 0` with `b > 0`: no time elapses, β₁ = β₀.
 /// - Cut-off: β₁ < ε gives 0 unless the bond is forming (β∞ = min(1, w/E) ≥ ε); see the module
 ///   documentation. With β₀ = 0 at a gap x the bond forms only if w/(C_n x²) ≥ ε.
-pub fn beta_update(beta0: f64, dt: f64, p: &RccParams, xn: f64, ut: [f64; 2]) -> f64 {
+pub fn beta_update(beta0: f64, dt: f64, p: &RccParams, xn: f64, ut: Vec2) -> f64 {
     beta_step(beta0, dt, p, stretch_energy(p, xn, ut)).0
 }
 
 /// Adhesive force r̃ = (−C_t u_t1 β² A, −C_t2 u_t2 β² A, −C_n x_n⁺ β² A) [N] for the intensity of
 /// adhesion `beta`, gap `xn` [m], bond stretch `ut` [m] and tributary area `area` [m²].
-pub fn adhesive_force(beta: f64, p: &RccParams, xn: f64, ut: [f64; 2], area: f64) -> [f64; 3] {
+pub fn adhesive_force(beta: f64, p: &RccParams, xn: f64, ut: Vec2, area: f64) -> Vec3 {
     let k = beta * beta * area;
-    [
+    Vec3::new(
         -p.ct * ut[0] * k,
         -p.ct2 * ut[1] * k,
         -p.cn * xn.max(0.0) * k,
-    ]
+    )
 }
 
 /// ρ [N/m] for the bi-potential iteration at a point with Delassus block `w_aa` [m/N]:
 /// 1/λ_max of its symmetric part. The fixed point r̄ ← Proj(r̄ − ρ(x + μ‖x_t‖n)) contracts for
 /// 0 < ρ < 2/λ_max; 1/λ_max is safely inside. (1/max W_ii can reach 3/λ_max and diverge.)
 /// Falls back to 1/max|W_ii|, then 1, for degenerate blocks.
-pub fn default_rho(w_aa: [[f64; 3]; 3]) -> f64 {
-    let w = mat3_from_rows(w_aa);
+pub fn default_rho(w_aa: Mat3) -> f64 {
+    let w = w_aa;
     let lmax = eig_sym3(&((w + w.transpose()) * 0.5))[2];
     if lmax.is_finite() && lmax > 0.0 {
         return 1.0 / lmax;
     }
-    let dmax = w_aa[0][0].abs().max(w_aa[1][1].abs()).max(w_aa[2][2].abs());
+    let dmax = w_aa[(0, 0)]
+        .abs()
+        .max(w_aa[(1, 1)].abs())
+        .max(w_aa[(2, 2)].abs());
     if dmax.is_finite() && dmax > 0.0 {
         1.0 / dmax
     } else {
@@ -417,9 +419,9 @@ pub fn default_rho(w_aa: [[f64; 3]; 3]) -> f64 {
 #[derive(Clone, Copy, Debug)]
 pub struct PointProblem<'a> {
     /// Delassus diagonal block W_αα [m/N], symmetric positive definite.
-    pub w_aa: [[f64; 3]; 3],
+    pub w_aa: Mat3,
     /// x with the other points' current forces and this point's force removed [m].
-    pub x_free: [f64; 3],
+    pub x_free: Vec3,
     /// Interface law of the pair.
     pub law: &'a InterfaceLaw,
     /// Committed interface state at the start of the step.
@@ -436,15 +438,15 @@ pub struct PointProblem<'a> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PointSolution {
     /// Dry part r̄ [N], in the Coulomb cone.
-    pub r_dry: [f64; 3],
+    pub r_dry: Vec3,
     /// Adhesive part r̃ [N].
-    pub r_adh: [f64; 3],
+    pub r_adh: Vec3,
     /// Local relative displacement x = x_free + W_αα (r̄ + r̃) [m].
-    pub x: [f64; 3],
+    pub x: Vec3,
     /// Intensity of adhesion β₁ at the end of the step [-].
     pub beta: f64,
     /// Bond stretch to commit [m]: u_t0 + x_t while bonded (β₁ > 0), else 0.
-    pub ut: [f64; 2],
+    pub ut: Vec2,
     /// Case of the solution: apart (r̄ = 0, x_n ≥ 0), stick (x = 0) or slide (r̄ on the cone,
     /// opposing the slip, x_n = 0). Whether the point is bonded is `beta > 0`.
     pub state: ContactState,
@@ -456,8 +458,8 @@ pub struct PointSolution {
 
 impl PointSolution {
     /// Total contact force r = r̄ + r̃ [N].
-    pub fn r(&self) -> [f64; 3] {
-        (Vec3::from(self.r_dry) + Vec3::from(self.r_adh)).into()
+    pub fn r(&self) -> Vec3 {
+        self.r_dry + self.r_adh
     }
 
     /// Whether an adhesive bond is present (β > 0).
@@ -492,12 +494,7 @@ impl PointSolution {
 /// strongly coupled W, or softening adhesion), the first in the order apart, stick, slide wins.
 /// `rho` is only used by the check and the fallback (a non-positive ρ is replaced by
 /// [`default_rho`]); the solution does not depend on it. r̄ lies in K_μ to rounding.
-pub fn solve_point(
-    p: &PointProblem,
-    r_start: [f64; 3],
-    tol: f64,
-    max_iter: usize,
-) -> PointSolution {
+pub fn solve_point(p: &PointProblem, r_start: Vec3, tol: f64, max_iter: usize) -> PointSolution {
     solve_point_impl(p, r_start, tol, max_iter, Method::Cases)
 }
 
@@ -529,7 +526,7 @@ pub struct AdhEval {
     /// β₁ [-].
     pub beta: f64,
     /// Bond stretch u_t0 + x_t [m].
-    pub ut: [f64; 2],
+    pub ut: Vec2,
     /// Adhesive force r̃ [N].
     pub force: Vec3,
     /// −∂r̃/∂x [N/m] (symmetric).
@@ -573,7 +570,7 @@ enum Method {
 /// problem of its scaled variables r' = T⁻¹r, x' = Tx ([`super::anisotropic`]).
 fn solve_point_impl(
     p: &PointProblem,
-    r_start: [f64; 3],
+    r_start: Vec3,
     tol: f64,
     max_iter: usize,
     method: Method,
@@ -605,7 +602,7 @@ fn solve_point_impl(
 /// (x' = T x, r' = T⁻¹ r, T = diag(1, t2, 1)); `p.law` is isotropic there.
 fn solve_scaled(
     p: &PointProblem,
-    r_start: [f64; 3],
+    r_start: Vec3,
     tol: f64,
     max_iter: usize,
     method: Method,
@@ -622,8 +619,8 @@ fn solve_scaled(
     } else {
         default_rho(p.w_aa)
     };
-    let w = mat3_from_rows(p.w_aa);
-    let x_free = Vec3::from(p.x_free);
+    let w = p.w_aa;
+    let x_free = p.x_free;
     let scale = rho * x_free.norm() + adh_scale;
     let tol = if tol.is_finite() && tol > 0.0 {
         tol
@@ -642,7 +639,7 @@ fn solve_scaled(
         tol_in: (1e-3 * tol).max(1e-13),
     };
     let r0 = if r_start.iter().all(|v| v.is_finite()) {
-        Vec3::from(r_start)
+        r_start
     } else {
         Vec3::zeros()
     };
@@ -670,12 +667,12 @@ fn finish(ev: &Eval, state: ContactState, iterations: usize, converged: bool) ->
     let ut = if ev.adh.beta > 0.0 {
         ev.adh.ut
     } else {
-        [0.0; 2]
+        Vec2::zeros()
     };
     PointSolution {
-        r_dry: ev.r_dry.into(),
-        r_adh: ev.r_adh.into(),
-        x: ev.x.into(),
+        r_dry: ev.r_dry,
+        r_adh: ev.r_adh,
+        x: ev.x,
         beta: ev.adh.beta,
         ut,
         state,
@@ -776,9 +773,9 @@ fn solve_slide(
     } else {
         match r_stick {
             Some(rs) => {
-                let (pr, _) = dry_projection(rs.into(), mu);
+                let (pr, _) = dry_projection(rs, mu);
                 if pr[0].hypot(pr[1]) > 0.0 {
-                    Vec3::from(pr)
+                    pr
                 } else {
                     Vec3::new(rs[0], rs[1], pr[2])
                 }
@@ -885,8 +882,8 @@ fn bipotential_iteration(
             if let Some(step) = newton_step(ctx, &ev) {
                 let mut alpha = 1.0;
                 for _ in 0..NEWTON_HALVINGS {
-                    let trial = dry_projection((ev.r_dry + step * alpha).into(), ctx.mu).0;
-                    let cand = evaluate(ctx, Vec3::from(trial), ev.r_adh);
+                    let trial = dry_projection(ev.r_dry + step * alpha, ctx.mu).0;
+                    let cand = evaluate(ctx, trial, ev.r_adh);
                     if cand.f.norm() < (1.0 - 1e-4 * alpha) * fn_old {
                         next = Some(cand);
                         break;
@@ -920,9 +917,8 @@ fn evaluate(ctx: &Ctx, r_dry: Vec3, z_start: Vec3) -> Eval {
     } else {
         (y, Vec3::zeros(), AdhEval::default())
     };
-    let r_star = Vec3::from(bipotential_trial(r_dry.into(), x.into(), ctx.mu, ctx.rho));
-    let (proj, case) = dry_projection(r_star.into(), ctx.mu);
-    let proj = Vec3::from(proj);
+    let r_star = bipotential_trial(r_dry, x, ctx.mu, ctx.rho);
+    let (proj, case) = dry_projection(r_star, ctx.mu);
     Eval {
         r_dry,
         x,
@@ -936,7 +932,7 @@ fn evaluate(ctx: &Ctx, r_dry: Vec3, z_start: Vec3) -> Eval {
 }
 
 /// Stretch energy density E = C_n x_n⁺² + C_t ‖u_t‖² [N/m].
-fn stretch_energy(p: &RccParams, xn: f64, ut: [f64; 2]) -> f64 {
+fn stretch_energy(p: &RccParams, xn: f64, ut: Vec2) -> f64 {
     let xp = xn.max(0.0);
     let tangential = if p.ct2 == p.ct {
         p.ct * (ut[0] * ut[0] + ut[1] * ut[1])
@@ -986,14 +982,12 @@ fn beta_step(beta0: f64, dt: f64, p: &RccParams, e: f64) -> (f64, f64) {
 fn adhesion_eval(ctx: &Ctx, x: Vec3) -> AdhEval {
     let (p, s) = (ctx.p, ctx.t2);
     if s == 1.0 {
-        return p.law.adhesion_at(&p.bond0, p.dt, p.area, x.into());
+        return p.law.adhesion_at(&p.bond0, p.dt, p.area, x);
     }
     // x is scaled (x' = T x): the law at T⁻¹x', its force as T⁻¹r̃ and stiffness T⁻¹KT⁻¹.
-    let mut ev = p
-        .law
-        .adhesion_at(&p.bond0, p.dt, p.area, unscale(x.into(), s));
-    ev.force = Vec3::from(unscale(ev.force.into(), s));
-    ev.stiff = mat3_from_rows(unscale_matrix(rows_of(&ev.stiff), s));
+    let mut ev = p.law.adhesion_at(&p.bond0, p.dt, p.area, unscale(x, s));
+    ev.force = unscale(ev.force, s);
+    ev.stiff = unscale_matrix(ev.stiff, s);
     ev
 }
 
@@ -1004,13 +998,13 @@ pub(super) fn rcc_adhesion_at(
     dt: f64,
     area: f64,
     a: &RccParams,
-    x: [f64; 3],
+    x: Vec3,
 ) -> AdhEval {
     let a = &a.degraded(bond0.damage);
-    let ut = [bond0.ut[0] + x[0], bond0.ut[1] + x[1]];
+    let ut = bond0.ut + x.xy();
     let e = stretch_energy(a, x[2], ut);
     let (beta, c) = beta_step(bond0.beta, dt, a, e);
-    let force = Vec3::from(adhesive_force(beta, a, x[2], ut, area));
+    let force = adhesive_force(beta, a, x[2], ut, area);
     let xp = x[2].max(0.0);
     let mut energy = 0.5 * e * beta * beta - a.w.max(0.0) * beta;
     if a.b > 0.0 && dt > 0.0 {
@@ -1047,12 +1041,12 @@ pub struct AdhesiveResponse {
     /// β₁ at the end of the step [-].
     pub beta: f64,
     /// Bond stretch to commit [m]: u_t0 + x_t while bonded (β₁ > 0), else 0.
-    pub ut: [f64; 2],
+    pub ut: Vec2,
     /// Adhesive force r̃ [N] in the local frame.
-    pub force: [f64; 3],
+    pub force: Vec3,
     /// −∂r̃/∂x with β₁ held fixed [N/m]: A β₁² diag(C_t, C_t, C_n [x_n > 0]), symmetric
     /// positive semi-definite (the softening part from ∂β₁/∂x is left out).
-    pub secant_stiffness: [[f64; 3]; 3],
+    pub secant_stiffness: Mat3,
     /// Incremental potential of the bond φ [J], with ∂φ/∂x = −r̃.
     pub energy: f64,
 }
@@ -1063,20 +1057,20 @@ pub fn adhesive_response(
     bond0: BondState,
     dt: f64,
     area: f64,
-    x: [f64; 3],
+    x: Vec3,
 ) -> AdhesiveResponse {
     let ev = rcc_adhesion_at(bond0, dt, area, a, x);
     let k = area * ev.beta * ev.beta;
-    let mut secant_stiffness = [[0.0; 3]; 3];
-    if ev.beta > 0.0 {
-        secant_stiffness[0][0] = k * a.ct;
-        secant_stiffness[1][1] = k * a.ct2;
-        secant_stiffness[2][2] = if x[2] > 0.0 { k * a.cn } else { 0.0 };
-    }
+    let secant_stiffness = if ev.beta > 0.0 {
+        let kn = if x[2] > 0.0 { k * a.cn } else { 0.0 };
+        Mat3::from_diagonal(&Vec3::new(k * a.ct, k * a.ct2, kn))
+    } else {
+        Mat3::zeros()
+    };
     AdhesiveResponse {
         beta: ev.beta,
-        ut: if ev.beta > 0.0 { ev.ut } else { [0.0; 2] },
-        force: ev.force.into(),
+        ut: if ev.beta > 0.0 { ev.ut } else { Vec2::zeros() },
+        force: ev.force,
         secant_stiffness,
         energy: ev.energy,
     }
@@ -1199,39 +1193,39 @@ fn shifted_newton_direction(w: &Mat3, k: &Mat3, grad: &Vec3) -> Option<Vec3> {
 fn newton_step(ctx: &Ctx, ev: &Eval) -> Option<Vec3> {
     let m = Mat3::identity() + ctx.w * ev.adh.stiff;
     let we = solve3_mat(&m, &ctx.w)?;
-    let gw = mat3_from_rows(modified_displacement_jacobian(ev.x.into(), ctx.mu)) * we;
+    let gw = modified_displacement_jacobian(ev.x, ctx.mu) * we;
     let a = Mat3::identity() - gw * ctx.rho;
-    let pj = mat3_from_rows(projection_jacobian(ev.r_star.into(), ctx.mu, ev.case));
+    let pj = projection_jacobian(ev.r_star, ctx.mu, ev.case);
     let jac = Mat3::identity() - pj * a;
     solve3(&jac, &-ev.f).filter(|d| d.iter().all(|v| v.is_finite()))
 }
 
 /// Jacobian of [`dry_projection`] at `r_star` in the given case (symmetric, eigenvalues in
 /// [0, 1]).
-pub fn projection_jacobian(r_star: [f64; 3], mu: f64, case: ContactState) -> [[f64; 3]; 3] {
+pub fn projection_jacobian(r_star: Vec3, mu: f64, case: ContactState) -> Mat3 {
     match case {
-        ContactState::Apart => [[0.0; 3]; 3],
-        ContactState::Stick => [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        ContactState::Apart => Mat3::zeros(),
+        ContactState::Stick => Mat3::identity(),
         ContactState::Slide => {
             let s = r_star[0].hypot(r_star[1]);
             let q = 1.0 + mu * mu;
             if s.is_nan() || s <= 0.0 {
-                let mut j = [[0.0; 3]; 3];
-                j[2][2] = 1.0 / q;
+                let mut j = Mat3::zeros();
+                j[(2, 2)] = 1.0 / q;
                 return j;
             }
             let t = [r_star[0] / s, r_star[1] / s];
             let rn = ((r_star[2] + mu * s) / q).max(0.0);
-            let mut j = [[0.0; 3]; 3];
+            let mut j = Mat3::zeros();
             for a in 0..2 {
                 for b in 0..2 {
                     let delta = if a == b { 1.0 } else { 0.0 };
-                    j[a][b] = mu * mu * t[a] * t[b] / q + mu * rn / s * (delta - t[a] * t[b]);
+                    j[(a, b)] = mu * mu * t[a] * t[b] / q + mu * rn / s * (delta - t[a] * t[b]);
                 }
-                j[a][2] = mu * t[a] / q;
-                j[2][a] = mu * t[a] / q;
+                j[(a, 2)] = mu * t[a] / q;
+                j[(2, a)] = mu * t[a] / q;
             }
-            j[2][2] = 1.0 / q;
+            j[(2, 2)] = 1.0 / q;
             j
         }
     }
@@ -1371,10 +1365,22 @@ fn eig_sym3(a: &Mat3) -> Vec3 {
 mod tests {
     use super::*;
 
-    /// A force or displacement in local components, as the public functions take it.
-    type V3 = [f64; 3];
-    /// A 3×3 block in rows, as the public functions take it.
-    type M3 = [[f64; 3]; 3];
+    use crate::mat3_from_rows;
+
+    /// A force or displacement in local components.
+    type V3 = Vec3;
+    /// A 3×3 block (W, stiffness, Jacobian).
+    type M3 = Mat3;
+
+    /// A local vector from its components.
+    fn v3(a: f64, b: f64, c: f64) -> V3 {
+        Vec3::new(a, b, c)
+    }
+
+    /// A 3×3 block from its rows.
+    fn m3(rows: [[f64; 3]; 3]) -> M3 {
+        mat3_from_rows(rows)
+    }
 
     /// Deterministic generator for randomised tests (splitmix64).
     struct Rng(u64);
@@ -1411,18 +1417,12 @@ mod tests {
                 q[i] /= n;
             }
             let l = [lo, self.uniform(lo, hi), hi];
-            let mut m = [[0.0; 3]; 3];
-            for i in 0..3 {
-                for j in 0..3 {
-                    m[i][j] = (0..3).map(|k| q[k][i] * l[k] * q[k][j]).sum();
-                }
-            }
-            m
+            M3::from_fn(|i, j| (0..3).map(|k| q[k][i] * l[k] * q[k][j]).sum())
         }
     }
 
     fn diag(a: f64, b: f64, c: f64) -> M3 {
-        [[a, 0.0, 0.0], [0.0, b, 0.0], [0.0, 0.0, c]]
+        m3([[a, 0.0, 0.0], [0.0, b, 0.0], [0.0, 0.0, c]])
     }
 
     fn rel(a: f64, b: f64) -> f64 {
@@ -1462,7 +1462,7 @@ mod tests {
     /// r̄ ∈ K_μ, Signorini complementarity, Coulomb sliding rule, and the RCC part.
     fn check_solution(p: &PointProblem, s: &PointSolution, tol: f64) {
         let r = Vec3::from(s.r());
-        let (w, x_free) = (mat3_from_rows(p.w_aa), Vec3::from(p.x_free));
+        let (w, x_free) = (p.w_aa, p.x_free);
         let x = x_free + w * r;
         let xs = x_free.norm().max(x.norm()).max(f64::MIN_POSITIVE);
         let parts = xs + (w * Vec3::from(s.r_dry)).norm() + (w * Vec3::from(s.r_adh)).norm();
@@ -1479,7 +1479,7 @@ mod tests {
         let xt = x[0].hypot(x[1]);
         match s.state {
             ContactState::Apart => {
-                assert_eq!(rd, [0.0; 3]);
+                assert_eq!(rd, V3::zeros());
                 assert!(x[2] >= -tol * xs, "apart means open gap: {}", x[2]);
             }
             ContactState::Stick => {
@@ -1497,9 +1497,9 @@ mod tests {
             }
         }
         match &p.law.adhesion {
-            None => assert_eq!(s.r_adh, [0.0; 3]),
+            None => assert_eq!(s.r_adh, V3::zeros()),
             Some(a) => {
-                let ut = [p.bond0.ut[0] + x[0], p.bond0.ut[1] + x[1]];
+                let ut = Vec2::new(p.bond0.ut[0] + x[0], p.bond0.ut[1] + x[1]);
                 let beta = beta_update(p.bond0.beta, p.dt, a, x[2], ut);
                 assert!((beta - s.beta).abs() <= 1e-9, "β {beta} vs {}", s.beta);
                 let ra = adhesive_force(beta, a, x[2], ut, p.area);
@@ -1518,35 +1518,35 @@ mod tests {
     #[test]
     fn projection_cases_match_hand_values() {
         // Separating: μ‖r*_t‖ = 0.05 < 1 = −r*_n.
-        let (r, c) = dry_projection([0.1, 0.0, -1.0], 0.5);
-        assert_eq!((r, c), ([0.0; 3], ContactState::Apart));
+        let (r, c) = dry_projection(v3(0.1, 0.0, -1.0), 0.5);
+        assert_eq!((r, c), (V3::zeros(), ContactState::Apart));
         // Sticking: ‖r*_t‖ = 0.5 ≤ 1 = μ r*_n.
-        let (r, c) = dry_projection([0.3, 0.4, 2.0], 0.5);
-        assert_eq!((r, c), ([0.3, 0.4, 2.0], ContactState::Stick));
+        let (r, c) = dry_projection(v3(0.3, 0.4, 2.0), 0.5);
+        assert_eq!((r, c), (v3(0.3, 0.4, 2.0), ContactState::Stick));
         // Sliding (docs/model.md §5.1): μ = 1, r* = (2, 0, 0) → r_n = 1, r_t = (1, 0).
-        let (r, c) = dry_projection([2.0, 0.0, 0.0], 1.0);
+        let (r, c) = dry_projection(v3(2.0, 0.0, 0.0), 1.0);
         assert_eq!(c, ContactState::Slide);
-        assert_vec_close(r, [1.0, 0.0, 1.0], 1e-15);
+        assert_vec_close(r, v3(1.0, 0.0, 1.0), 1e-15);
         // Sliding: μ = 0.5, r* = (3, 4, 1): r_n = (1 + 2.5)/1.25 = 2.8, r_t = 1.4 (0.6, 0.8).
-        let (r, c) = dry_projection([3.0, 4.0, 1.0], 0.5);
+        let (r, c) = dry_projection(v3(3.0, 4.0, 1.0), 0.5);
         assert_eq!(c, ContactState::Slide);
-        assert_vec_close(r, [0.84, 1.12, 2.8], 1e-15);
+        assert_vec_close(r, v3(0.84, 1.12, 2.8), 1e-15);
         // Sliding from below the apex plane: μ = 2, r* = (3, 0, −1): r_n = (−1 + 6)/5 = 1.
-        let (r, c) = dry_projection([3.0, 0.0, -1.0], 2.0);
+        let (r, c) = dry_projection(v3(3.0, 0.0, -1.0), 2.0);
         assert_eq!(c, ContactState::Slide);
-        assert_vec_close(r, [2.0, 0.0, 1.0], 1e-15);
+        assert_vec_close(r, v3(2.0, 0.0, 1.0), 1e-15);
     }
 
     #[test]
     fn projection_frictionless() {
-        let (r, c) = dry_projection([1.0, -2.0, 3.0], 0.0);
-        assert_eq!((r, c), ([0.0, 0.0, 3.0], ContactState::Slide));
-        let (r, c) = dry_projection([1.0, -2.0, -3.0], 0.0);
-        assert_eq!((r, c), ([0.0; 3], ContactState::Apart));
-        let (r, c) = dry_projection([0.0, 0.0, 3.0], 0.0);
-        assert_eq!((r, c), ([0.0, 0.0, 3.0], ContactState::Stick));
+        let (r, c) = dry_projection(v3(1.0, -2.0, 3.0), 0.0);
+        assert_eq!((r, c), (v3(0.0, 0.0, 3.0), ContactState::Slide));
+        let (r, c) = dry_projection(v3(1.0, -2.0, -3.0), 0.0);
+        assert_eq!((r, c), (V3::zeros(), ContactState::Apart));
+        let (r, c) = dry_projection(v3(0.0, 0.0, 3.0), 0.0);
+        assert_eq!((r, c), (v3(0.0, 0.0, 3.0), ContactState::Stick));
         // Negative μ is treated as 0.
-        assert_eq!(dry_projection([1.0, 0.0, 1.0], -0.5).0, [0.0, 0.0, 1.0]);
+        assert_eq!(dry_projection(v3(1.0, 0.0, 1.0), -0.5).0, v3(0.0, 0.0, 1.0));
     }
 
     #[test]
@@ -1554,24 +1554,24 @@ mod tests {
         // r* − r = (‖r*_t‖ − μ r*_n)/(1 + μ²) (t̂, −μ): normal to the cone's generator (μ t̂, 1)
         // through r, and r itself lies on that generator.
         let mu = 0.7;
-        let rs = [1.5, -2.0, 0.4];
+        let rs = v3(1.5, -2.0, 0.4);
         let (r, c) = dry_projection(rs, mu);
         assert_eq!(c, ContactState::Slide);
         let st = rs[0].hypot(rs[1]);
         let t = [rs[0] / st, rs[1] / st];
         let k = (st - mu * rs[2]) / (1.0 + mu * mu);
         let y = Vec3::from(rs) - Vec3::from(r);
-        assert_vec_close(y.into(), [k * t[0], k * t[1], -k * mu], 1e-14);
+        assert_vec_close(y, v3(k * t[0], k * t[1], -k * mu), 1e-14);
         let gen = [mu * t[0], mu * t[1], 1.0];
         assert!(y.dot(&Vec3::from(gen)).abs() <= 1e-14 * Vec3::from(rs).norm());
         let rn = r[2];
-        assert_vec_close(r, [rn * gen[0], rn * gen[1], rn * gen[2]], 1e-14);
+        assert_vec_close(r, v3(rn * gen[0], rn * gen[1], rn * gen[2]), 1e-14);
     }
 
     #[test]
     fn paper_plus_sign_would_leave_the_cone() {
         // Eq 32 as printed: r = r* − (‖r*_t‖ − μ r*_n)/(1 + μ²) (t̂ + μ n).
-        let (mu, rs) = (1.0, [2.0, 0.0, 0.0]);
+        let (mu, rs) = (1.0, v3(2.0, 0.0, 0.0));
         let k = (2.0 - mu * 0.0) / (1.0 + mu * mu);
         let printed = [rs[0] - k, rs[1], rs[2] - k * mu];
         assert!(printed[2] < 0.0, "printed sign gives r_n = {}", printed[2]);
@@ -1590,11 +1590,11 @@ mod tests {
                 rng.uniform(0.0, 1.5)
             };
             let mag = 10f64.powf(rng.uniform(-6.0, 6.0));
-            let rs = [
+            let rs = v3(
                 mag * rng.uniform(-1.0, 1.0),
                 mag * rng.uniform(-1.0, 1.0),
                 mag * rng.uniform(-1.0, 1.0),
-            ];
+            );
             let (r, c) = dry_projection(rs, mu);
             hits[c as usize] += 1;
             let s = Vec3::from(rs).norm();
@@ -1624,7 +1624,7 @@ mod tests {
                 let kn = mag * rng.uniform(0.0, 2.0);
                 let ang = rng.uniform(0.0, 2.0 * PI);
                 let kt = mu * kn * rng.uniform(0.0, 1.0);
-                let k = [kt * ang.cos(), kt * ang.sin(), kn];
+                let k = v3(kt * ang.cos(), kt * ang.sin(), kn);
                 assert!((Vec3::from(rs) - Vec3::from(k)).norm() >= d - tol);
             }
         }
@@ -1634,8 +1634,8 @@ mod tests {
     #[test]
     fn bipotential_trial_by_hand() {
         // r* = r̄ − ρ (x + μ‖x_t‖ n): ‖x_t‖ = 5e-3, μ‖x_t‖ = 2.5e-3.
-        let r = bipotential_trial([1.0, 2.0, 3.0], [3e-3, -4e-3, 1e-3], 0.5, 100.0);
-        assert_vec_close(r, [0.7, 2.4, 3.0 - 0.35], 1e-15);
+        let r = bipotential_trial(v3(1.0, 2.0, 3.0), v3(3e-3, -4e-3, 1e-3), 0.5, 100.0);
+        assert_vec_close(r, v3(0.7, 2.4, 3.0 - 0.35), 1e-15);
     }
 
     // ------------------------------------------------------------------ β and adhesive force
@@ -1646,7 +1646,7 @@ mod tests {
         let dt = 1.5e-4; // Δt w/b = 0.03
         let mut beta = 0.0;
         for k in 1..=50 {
-            beta = beta_update(beta, dt, &p, 0.0, [0.0; 2]);
+            beta = beta_update(beta, dt, &p, 0.0, Vec2::zeros());
             let expect = (k as f64 * dt * p.w / p.b).min(1.0);
             assert!(
                 (beta - expect).abs() <= 1e-13,
@@ -1655,7 +1655,7 @@ mod tests {
         }
         assert_eq!(beta, 1.0);
         // A negative gap stretches nothing.
-        assert!((beta_update(0.0, dt, &p, -1e-3, [0.0; 2]) - 0.03).abs() <= 1e-15);
+        assert!((beta_update(0.0, dt, &p, -1e-3, Vec2::zeros()) - 0.03).abs() <= 1e-15);
     }
 
     #[test]
@@ -1665,7 +1665,7 @@ mod tests {
         let dt = 5e-9;
         let mut beta = 0.0;
         for _ in 0..1000 {
-            beta = beta_update(beta, dt, &p, 0.0, [0.0; 2]);
+            beta = beta_update(beta, dt, &p, 0.0, Vec2::zeros());
         }
         assert!((beta - 1e-3).abs() <= 1e-12, "{beta}");
     }
@@ -1683,11 +1683,11 @@ mod tests {
             let dt = t_end / n as f64;
             let mut b = 1.0;
             for _ in 0..n {
-                b = beta_update(b, dt, &p, x, [0.0; 2]);
+                b = beta_update(b, dt, &p, x, Vec2::zeros());
             }
             (b - exact).abs()
         };
-        let e = [err(40), err(80), err(160)];
+        let e = v3(err(40), err(80), err(160));
         let o1 = (e[0] / e[1]).log2();
         let o2 = (e[1] / e[2]).log2();
         assert!(
@@ -1698,13 +1698,13 @@ mod tests {
         // Long hold: the equilibrium β∞ is reached.
         let mut b = 1.0;
         for _ in 0..200 {
-            b = beta_update(b, tau, &p, x, [0.0; 2]);
+            b = beta_update(b, tau, &p, x, Vec2::zeros());
         }
         assert!(rel(b, binf) < 1e-12);
         // The same with a tangential stretch: E = C_t ‖u_t‖² only.
         let mut b = 1.0;
         for _ in 0..200 {
-            b = beta_update(b, tau, &p, 0.0, [0.6 * x, 0.8 * x]);
+            b = beta_update(b, tau, &p, 0.0, Vec2::new(0.6 * x, 0.8 * x));
         }
         assert!(rel(b, binf) < 1e-12);
     }
@@ -1722,11 +1722,11 @@ mod tests {
                 1.0
             };
             for dt in [1e-3, 0.0] {
-                let b = beta_update(0.3, dt, &p, x, [0.0; 2]);
+                let b = beta_update(0.3, dt, &p, x, Vec2::zeros());
                 assert!(rel(b, expect) < 1e-14, "x = {f} x_c: {b} vs {expect}");
             }
         }
-        let b = beta_update(0.0, 1.0, &p, xc, [xc, 0.0]);
+        let b = beta_update(0.0, 1.0, &p, xc, Vec2::new(xc, 0.0));
         assert!(rel(b, 0.5) < 1e-14);
     }
 
@@ -1736,32 +1736,32 @@ mod tests {
         let xc = p.critical_opening();
         // A decaying bond that falls below ε is broken.
         let x = 200.0 * xc; // β∞ = 2.5e-5 < ε
-        assert_eq!(beta_update(2e-4, 1.0, &p, x, [0.0; 2]), 0.0);
+        assert_eq!(beta_update(2e-4, 1.0, &p, x, Vec2::zeros()), 0.0);
         // Still above ε: kept.
-        let b = beta_update(2e-4, 1e-9, &p, x, [0.0; 2]);
+        let b = beta_update(2e-4, 1e-9, &p, x, Vec2::zeros());
         assert!(b > 1e-4 && b < 2e-4);
         // β₀ = 0 far away: no bond.
-        assert_eq!(beta_update(0.0, 1e-3, &p, x, [0.0; 2]), 0.0);
+        assert_eq!(beta_update(0.0, 1e-3, &p, x, Vec2::zeros()), 0.0);
         // β₀ = 0 within √(w/(ε C_n)) = 100 x_c: the bond forms, per the law.
         let x = 50.0 * xc; // β∞ = 4e-4
         let dt = 1e-7;
-        let b = beta_update(0.0, dt, &p, x, [0.0; 2]);
+        let b = beta_update(0.0, dt, &p, x, Vec2::zeros());
         let expect = dt * p.w / (p.b + dt * p.cn * x * x);
         assert!(b < p.eps && rel(b, expect) < 1e-14, "{b} vs {expect}");
         let dt = 1e-3;
         // Rate-independent: β = β∞ cut at ε.
         let mut q = p;
         q.b = 0.0;
-        assert_eq!(beta_update(0.0, dt, &q, 200.0 * xc, [0.0; 2]), 0.0);
-        assert!(rel(beta_update(0.0, dt, &q, x, [0.0; 2]), 4e-4) < 1e-12);
+        assert_eq!(beta_update(0.0, dt, &q, 200.0 * xc, Vec2::zeros()), 0.0);
+        assert!(rel(beta_update(0.0, dt, &q, x, Vec2::zeros()), 4e-4) < 1e-12);
         // A larger ε cuts more.
         q.eps = 1e-3;
-        assert_eq!(beta_update(0.0, dt, &q, x, [0.0; 2]), 0.0);
+        assert_eq!(beta_update(0.0, dt, &q, x, Vec2::zeros()), 0.0);
     }
 
     #[test]
     fn beta_stays_in_unit_interval() {
-        // β₁ ∈ [0, 1], lies between β₀ and β∞ = min(1, w/E), and is below ε only while forming.
+        // β₁ ∈ Vec2::new(0, 1), lies between β₀ and β∞ = min(1, w/E), and is below ε only while forming.
         let mut rng = Rng(11);
         for _ in 0..10_000 {
             let p = RccParams {
@@ -1780,7 +1780,7 @@ mod tests {
             let p = RccParams { ct2: p.ct, ..p };
             let beta0 = rng.uniform(0.0, 1.0);
             let xn = rng.uniform(-1e-3, 1e-3);
-            let ut = [rng.uniform(-1e-3, 1e-3), rng.uniform(-1e-3, 1e-3)];
+            let ut = Vec2::new(rng.uniform(-1e-3, 1e-3), rng.uniform(-1e-3, 1e-3));
             let b = beta_update(beta0, 10f64.powf(rng.uniform(-8.0, 0.0)), &p, xn, ut);
             assert!((0.0..=1.0).contains(&b), "{b}");
             let e = stretch_energy(&p, xn, ut);
@@ -1801,21 +1801,24 @@ mod tests {
         }
         // Out-of-range β₀ is clamped.
         let p = paper_rcc();
-        assert_eq!(beta_update(1.5, 0.0, &p, 0.0, [0.0; 2]), 1.0);
-        assert_eq!(beta_update(-0.5, 0.0, &p, 0.0, [0.0; 2]), 0.0);
+        assert_eq!(beta_update(1.5, 0.0, &p, 0.0, Vec2::zeros()), 1.0);
+        assert_eq!(beta_update(-0.5, 0.0, &p, 0.0, Vec2::zeros()), 0.0);
     }
 
     #[test]
     fn adhesive_force_signs_and_values() {
         let p = paper_rcc();
-        let r = adhesive_force(0.5, &p, 1e-5, [2e-5, -1e-5], 1e-6);
+        let r = adhesive_force(0.5, &p, 1e-5, Vec2::new(2e-5, -1e-5), 1e-6);
         // β² A = 2.5e-7: C_n x β² A = 2e9 · 1e-5 · 2.5e-7 = 5e-3 N.
-        assert_vec_close(r, [-1e-2, 5e-3, -5e-3], 1e-14);
+        assert_vec_close(r, v3(-1e-2, 5e-3, -5e-3), 1e-14);
         // Closed gap: no normal adhesive force, tangential one still there.
-        let r = adhesive_force(1.0, &p, -1e-5, [1e-5, 0.0], 1e-6);
+        let r = adhesive_force(1.0, &p, -1e-5, Vec2::new(1e-5, 0.0), 1e-6);
         assert_eq!(r[2], 0.0);
         assert!(r[0] < 0.0);
-        assert_eq!(adhesive_force(0.0, &p, 1e-5, [1e-5, 1e-5], 1e-6), [0.0; 3]);
+        assert_eq!(
+            adhesive_force(0.0, &p, 1e-5, Vec2::new(1e-5, 1e-5), 1e-6),
+            V3::zeros()
+        );
     }
 
     #[test]
@@ -1832,8 +1835,8 @@ mod tests {
             // Uniform steps of x_c/1000 up to 3 x_c, then 0.1 % geometric growth.
             let dx = if x < 3.0 * xc { 1e-3 * xc } else { 1e-3 * x };
             x += dx;
-            beta = beta_update(beta, dx / v, &p, x, [0.0; 2]);
-            let t = -adhesive_force(beta, &p, x, [0.0; 2], 1.0)[2];
+            beta = beta_update(beta, dx / v, &p, x, Vec2::zeros());
+            let t = -adhesive_force(beta, &p, x, Vec2::zeros(), 1.0)[2];
             let b_qs = (p.w / (p.cn * x * x)).min(1.0);
             let t_qs = p.cn * x * b_qs * b_qs;
             if b_qs >= p.eps {
@@ -1876,15 +1879,15 @@ mod tests {
         let w = diag(1e-6, 1e-6, 1e-6);
         let mut bond = BondState {
             beta: 1.0,
-            ut: [0.0; 2],
+            ut: Vec2::zeros(),
             damage: 0.0,
         };
         let mut peak = 0.0_f64;
         for k in 1..=10_000 {
             let a = 1e-3 * k as f64 * xc;
-            let mut p = problem(&law, w, [0.0, 0.0, a], bond);
+            let mut p = problem(&law, w, v3(0.0, 0.0, a), bond);
             p.dt = 1.0;
-            let s = solve_point(&p, [0.0; 3], 1e-12, 50);
+            let s = solve_point(&p, V3::zeros(), 1e-12, 50);
             assert!(s.converged && s.iterations == 1, "step {k}: {s:?}");
             assert_eq!(s.state, ContactState::Apart);
             let x = s.x[2];
@@ -1918,13 +1921,13 @@ mod tests {
         let w = diag(0.05, 0.05, 0.05);
         let bond = BondState {
             beta: 1.0,
-            ut: [2e-5, 0.0],
+            ut: Vec2::new(2e-5, 0.0),
             damage: 0.0,
         };
         // r̃(0) = (−0.04, 0, 0) N; pressing with 0.2 N gives μ r_n = 0.08 N.
         for (shear, state) in [(0.0, ContactState::Stick), (-5e-3, ContactState::Slide)] {
-            let p = problem(&law, w, [shear, 0.0, -1e-2], bond);
-            let s = solve_point(&p, [0.0; 3], 1e-12, 50);
+            let p = problem(&law, w, v3(shear, 0.0, -1e-2), bond);
+            let s = solve_point(&p, V3::zeros(), 1e-12, 50);
             assert!(s.converged);
             assert_eq!(s.state, state, "shear {shear}");
             assert!(s.iterations <= 8, "{} iterations", s.iterations);
@@ -1937,17 +1940,17 @@ mod tests {
 
     #[test]
     fn default_rho_is_inverse_largest_eigenvalue() {
-        let w = [[2.0, 1.0, 0.0], [1.0, 2.0, 0.0], [0.0, 0.0, 1.0]];
+        let w = m3([[2.0, 1.0, 0.0], [1.0, 2.0, 0.0], [0.0, 0.0, 1.0]]);
         assert!(rel(default_rho(w), 1.0 / 3.0) < 1e-14);
         assert!(rel(default_rho(diag(1e-6, 2e-6, 4e-6)), 2.5e5) < 1e-14);
-        assert_eq!(default_rho([[0.0; 3]; 3]), 1.0);
+        assert_eq!(default_rho(M3::zeros()), 1.0);
         let mut rng = Rng(3);
         for _ in 0..1000 {
             let hi = 10f64.powf(rng.uniform(-6.9, -3.0));
             let w = rng.spd(1e-7, hi);
-            let ev = eig_sym3(&mat3_from_rows(w));
+            let ev = eig_sym3(&w);
             let hi = w
-                .iter()
+                .row_iter()
                 .map(|r| r.iter().map(|v| v.abs()).sum::<f64>())
                 .fold(0.0, f64::max);
             assert!(ev[2] <= hi * (1.0 + 1e-12) && ev[0] > 0.0);
@@ -1959,8 +1962,8 @@ mod tests {
     #[test]
     fn pressed_into_rigid_support() {
         let w = diag(1e-6, 1e-6, 2e-6);
-        let p = problem(&DRY, w, [0.0, 0.0, -1e-4], BondState::default());
-        let s = solve_point(&p, [0.0; 3], 1e-12, 50);
+        let p = problem(&DRY, w, v3(0.0, 0.0, -1e-4), BondState::default());
+        let s = solve_point(&p, V3::zeros(), 1e-12, 50);
         assert!(s.converged);
         assert_eq!(s.state, ContactState::Stick);
         assert!(s.x[2].abs() <= 1e-12 * 1e-4, "x_n = {}", s.x[2]);
@@ -1972,20 +1975,20 @@ mod tests {
     fn stick_then_slide() {
         let w = diag(1e-6, 1e-6, 2e-6);
         // Stick: the sticking force 10 N < μ r_n = 15 N.
-        let p = problem(&DRY, w, [1e-5, 0.0, -1e-4], BondState::default());
-        let s = solve_point(&p, [0.0; 3], 1e-12, 50);
+        let p = problem(&DRY, w, v3(1e-5, 0.0, -1e-4), BondState::default());
+        let s = solve_point(&p, V3::zeros(), 1e-12, 50);
         assert!(s.converged);
         assert_eq!(s.state, ContactState::Stick);
         assert!(s.x[0].hypot(s.x[1]) <= 1e-12 * 1e-4);
-        assert_vec_close(s.r(), [-10.0, 0.0, 50.0], 1e-10);
+        assert_vec_close(s.r(), v3(-10.0, 0.0, 50.0), 1e-10);
         check_solution(&p, &s, 1e-10);
         // Slide: the sticking force would be 50 N > 15 N.
-        let p = problem(&DRY, w, [3e-5, 4e-5, -1e-4], BondState::default());
-        let s = solve_point(&p, [0.0; 3], 1e-12, 50);
+        let p = problem(&DRY, w, v3(3e-5, 4e-5, -1e-4), BondState::default());
+        let s = solve_point(&p, V3::zeros(), 1e-12, 50);
         assert!(s.converged);
         assert_eq!(s.state, ContactState::Slide);
-        assert_vec_close(s.r(), [-9.0, -12.0, 50.0], 1e-10);
-        assert_vec_close(s.x, [2.1e-5, 2.8e-5, 0.0], 1e-10);
+        assert_vec_close(s.r(), v3(-9.0, -12.0, 50.0), 1e-10);
+        assert_vec_close(s.x, v3(2.1e-5, 2.8e-5, 0.0), 1e-10);
         check_solution(&p, &s, 1e-10);
         // Frictionless: r_t = 0, all of x_free_t becomes slip.
         let law = InterfaceLaw {
@@ -1993,21 +1996,21 @@ mod tests {
             adhesion: None,
             anisotropy: None,
         };
-        let p = problem(&law, w, [3e-5, 4e-5, -1e-4], BondState::default());
-        let s = solve_point(&p, [0.0; 3], 1e-12, 50);
+        let p = problem(&law, w, v3(3e-5, 4e-5, -1e-4), BondState::default());
+        let s = solve_point(&p, V3::zeros(), 1e-12, 50);
         assert!(s.converged);
-        assert_vec_close(s.r(), [0.0, 0.0, 50.0], 1e-12);
-        assert_vec_close(s.x, [3e-5, 4e-5, 0.0], 1e-10);
+        assert_vec_close(s.r(), v3(0.0, 0.0, 50.0), 1e-12);
+        assert_vec_close(s.x, v3(3e-5, 4e-5, 0.0), 1e-10);
     }
 
     #[test]
     fn apart_without_adhesion_has_no_force() {
         let w = diag(1e-6, 1e-6, 2e-6);
-        let p = problem(&DRY, w, [1e-5, 0.0, 1e-4], BondState::default());
-        let s = solve_point(&p, [5.0, 0.0, 30.0], 1e-12, 50);
+        let p = problem(&DRY, w, v3(1e-5, 0.0, 1e-4), BondState::default());
+        let s = solve_point(&p, v3(5.0, 0.0, 30.0), 1e-12, 50);
         assert!(s.converged);
         assert_eq!(s.state, ContactState::Apart);
-        assert_eq!(s.r(), [0.0; 3]);
+        assert_eq!(s.r(), V3::zeros());
         assert_eq!(s.x, p.x_free);
         assert!(s.iterations <= 2);
     }
@@ -2021,14 +2024,14 @@ mod tests {
         };
         let bond = BondState {
             beta: 1.0,
-            ut: [0.0; 2],
+            ut: Vec2::zeros(),
             damage: 0.0,
         };
         // C_n A = 2e3 N/m; C_n A W_nn = 0.2 (soft) and 100 (stiff adhesion).
         for wnn in [1e-4, 5e-2] {
             let w = diag(1e-4, 1e-4, wnn);
-            let p = problem(&law, w, [0.0, 0.0, 1e-5], bond);
-            let s = solve_point(&p, [0.0; 3], 1e-12, 50);
+            let p = problem(&law, w, v3(0.0, 0.0, 1e-5), bond);
+            let s = solve_point(&p, V3::zeros(), 1e-12, 50);
             assert!(s.converged, "W_nn = {wnn}");
             let k = 2e9 * 1e-6;
             let xn = 1e-5 / (1.0 + k * wnn);
@@ -2052,28 +2055,28 @@ mod tests {
         // Bonded, pressed and pulled sideways: stretch grows by the slip, bond survives.
         let bond = BondState {
             beta: 1.0,
-            ut: [1e-6, 0.0],
+            ut: Vec2::new(1e-6, 0.0),
             damage: 0.0,
         };
-        let p = problem(&law, w, [2e-3, 0.0, -1e-3], bond);
-        let s = solve_point(&p, [0.0; 3], 1e-12, 100);
+        let p = problem(&law, w, v3(2e-3, 0.0, -1e-3), bond);
+        let s = solve_point(&p, V3::zeros(), 1e-12, 100);
         assert!(s.converged);
         assert!(s.beta > 0.0);
-        assert_eq!(s.ut, [1e-6 + s.x[0], s.x[1]]);
+        assert_eq!(s.ut, Vec2::new(1e-6 + s.x[0], s.x[1]));
         check_solution(&p, &s, 1e-9);
         // Far apart with a weak bond: broken, stretch reset.
         let bond = BondState {
             beta: 2e-4,
-            ut: [1e-6, 0.0],
+            ut: Vec2::new(1e-6, 0.0),
             damage: 0.0,
         };
-        let mut p = problem(&law, w, [0.0, 0.0, 3e-2], bond);
+        let mut p = problem(&law, w, v3(0.0, 0.0, 3e-2), bond);
         p.dt = 1.0;
-        let s = solve_point(&p, [0.0; 3], 1e-12, 100);
+        let s = solve_point(&p, V3::zeros(), 1e-12, 100);
         assert!(s.converged);
         assert_eq!(s.beta, 0.0);
-        assert_eq!(s.ut, [0.0; 2]);
-        assert_eq!(s.r(), [0.0; 3]);
+        assert_eq!(s.ut, Vec2::zeros());
+        assert_eq!(s.r(), V3::zeros());
     }
 
     /// A set of point problems over stiffness ratios, loadings and bond states.
@@ -2098,7 +2101,7 @@ mod tests {
                 )
             };
             let mu = [0.0, 0.2, 0.4, 0.8, 1.2][(i / 10) % 5];
-            let rcc = RccParams::new(20.0, 2e9, 2e9, [0.1, 1e-6, 0.0][(i / 50) % 3]);
+            let rcc = RccParams::new(20.0, 2e9, 2e9, v3(0.1, 1e-6, 0.0)[(i / 50) % 3]);
             let law = InterfaceLaw {
                 mu,
                 adhesion: if ratio > 0.0 { Some(rcc) } else { None },
@@ -2106,14 +2109,14 @@ mod tests {
             };
             let xc = rcc.critical_opening();
             let a = 10f64.powf(rng.uniform(-2.0, 0.7)) * xc * (1.0 + ratio);
-            let x_free = [
+            let x_free = v3(
                 a * rng.uniform(-1.0, 1.0),
                 a * rng.uniform(-1.0, 1.0),
                 a * rng.uniform(-1.0, 1.0),
-            ];
+            );
             let bond = BondState {
                 beta: [0.0, 1.0, 0.5, 0.01][(i / 3) % 4],
-                ut: [xc * rng.uniform(-0.5, 0.5), xc * rng.uniform(-0.5, 0.5)],
+                ut: Vec2::new(xc * rng.uniform(-0.5, 0.5), xc * rng.uniform(-0.5, 0.5)),
                 damage: 0.0,
             };
             let p = PointProblem {
@@ -2139,7 +2142,7 @@ mod tests {
         let mut stats = [(0usize, 0usize, 0usize); 5];
         let mut states = [0usize; 3];
         sweep_cases(&mut rng, 1500, |p, label| {
-            let s = solve_point(p, [0.0; 3], 1e-10, 50);
+            let s = solve_point(p, V3::zeros(), 1e-10, 50);
             assert!(s.converged, "{label}: {s:?} {p:?}");
             check_solution(p, &s, 1e-8);
             let k = label_ratio_index(label);
@@ -2183,26 +2186,26 @@ mod tests {
         for i in 0..300 {
             let w = rng.spd(1e-6, 1e-5);
             let law = InterfaceLaw {
-                mu: [0.0, 0.3, 0.8][i % 3],
+                mu: v3(0.0, 0.3, 0.8)[i % 3],
                 adhesion: None,
                 anisotropy: None,
             };
-            let x_free = [
+            let x_free = v3(
                 rng.uniform(-1e-4, 1e-4),
                 rng.uniform(-1e-4, 1e-4),
                 rng.uniform(-1e-4, 1e-4),
-            ];
+            );
             let p = problem(&law, w, x_free, BondState::default());
             let fp = solve_point_impl(
                 &p,
-                [0.0; 3],
+                V3::zeros(),
                 1e-10,
                 5000,
                 Method::Bipotential { newton: false },
             );
             assert!(fp.converged, "case {i}");
             worst = worst.max(fp.iterations);
-            let nw = solve_point(&p, [0.0; 3], 1e-10, 50);
+            let nw = solve_point(&p, V3::zeros(), 1e-10, 50);
             assert!(nw.converged);
             assert_eq!(fp.state, nw.state, "case {i}");
             let scale = Vec3::from(fp.r()).norm() + p.rho * Vec3::from(x_free).norm();
@@ -2220,38 +2223,33 @@ mod tests {
         // W = εI + (1 − ε) v vᵀ, v = (1, 1, 1)/√3: λ_max = 1 but W_ii ≈ 1/3, so ρ = 1/max W_ii ≈ 3
         // exceeds 2/λ_max and the sticking iteration r ← r − ρ W r − ρ x_free diverges.
         let eps = 0.05;
-        let mut w = [[0.0; 3]; 3];
-        for (i, row) in w.iter_mut().enumerate() {
-            for (j, v) in row.iter_mut().enumerate() {
-                *v = (1.0 - eps) / 3.0 + if i == j { eps } else { 0.0 };
-            }
-        }
+        let w = M3::from_fn(|i, j| (1.0 - eps) / 3.0 + if i == j { eps } else { 0.0 });
         let law = InterfaceLaw {
             mu: 1.0,
             adhesion: None,
             anisotropy: None,
         };
-        let mut p = problem(&law, w, [0.0, 0.0, -1.0], BondState::default());
+        let mut p = problem(&law, w, v3(0.0, 0.0, -1.0), BondState::default());
         let ok = solve_point_impl(
             &p,
-            [0.0; 3],
+            V3::zeros(),
             1e-10,
             5000,
             Method::Bipotential { newton: false },
         );
         assert!(ok.converged);
         check_solution(&p, &ok, 1e-8);
-        p.rho = 1.0 / w[0][0];
+        p.rho = 1.0 / w[(0, 0)];
         let bad = solve_point_impl(
             &p,
-            [0.0; 3],
+            V3::zeros(),
             1e-10,
             5000,
             Method::Bipotential { newton: false },
         );
         assert!(!bad.converged);
         // The default solver does not depend on ρ for its answer.
-        let s = solve_point(&p, [0.0; 3], 1e-10, 50);
+        let s = solve_point(&p, V3::zeros(), 1e-10, 50);
         assert!(s.converged);
         assert!(
             (Vec3::from(s.r()) - Vec3::from(ok.r())).norm() <= 1e-8 * Vec3::from(ok.r()).norm()
@@ -2275,10 +2273,10 @@ mod tests {
         let w = diag(0.05, 0.05, 0.05);
         let mut bond = BondState {
             beta: 1.0,
-            ut: [0.0; 2],
+            ut: Vec2::zeros(),
             damage: 0.0,
         };
-        let mut r = [0.0; 3];
+        let mut r = V3::zeros();
         let mut snap_off = None;
         let mut snap_back = None;
         let mut prev_xn = 0.0;
@@ -2287,7 +2285,7 @@ mod tests {
             .chain((0..300).rev().map(|k| 0.5 * k as f64))
             .collect();
         for (k, &af) in steps.iter().enumerate() {
-            let mut p = problem(&law, w, [0.0, 0.0, af * xc], bond);
+            let mut p = problem(&law, w, v3(0.0, 0.0, af * xc), bond);
             p.dt = 1.0;
             let s = solve_point(&p, r, 1e-12, 50);
             assert!(s.converged, "step {k}");
@@ -2331,21 +2329,21 @@ mod tests {
         };
         let bond = BondState {
             beta: 1.0,
-            ut: [1e-5, 0.0],
+            ut: Vec2::new(1e-5, 0.0),
             damage: 0.0,
         };
         let cases: [(M3, V3, f64, f64); 6] = [
-            ([[0.0; 3]; 3], [0.0, 0.0, -1e-4], 1e-6, 1e-4),
-            ([[0.0; 3]; 3], [1e-5, 0.0, 1e-5], 1e-6, 1e-4),
-            (diag(1e-4, 1e-4, 1e-4), [1e-5, 0.0, 1e-5], 0.0, 1e-4),
-            (diag(1e-4, 1e-4, 1e-4), [1e-5, 0.0, 1e-5], 1e-6, 0.0),
+            (M3::zeros(), v3(0.0, 0.0, -1e-4), 1e-6, 1e-4),
+            (M3::zeros(), v3(1e-5, 0.0, 1e-5), 1e-6, 1e-4),
+            (diag(1e-4, 1e-4, 1e-4), v3(1e-5, 0.0, 1e-5), 0.0, 1e-4),
+            (diag(1e-4, 1e-4, 1e-4), v3(1e-5, 0.0, 1e-5), 1e-6, 0.0),
             (
                 diag(1e300, 1.0, 1e-300),
-                [1e300, -1e300, 1e-300],
+                v3(1e300, -1e300, 1e-300),
                 1e300,
                 1e300,
             ),
-            (diag(1e-4, 1e-4, 1e-4), [f64::NAN, 0.0, 1.0], 1e-6, 1e-4),
+            (diag(1e-4, 1e-4, 1e-4), v3(f64::NAN, 0.0, 1.0), 1e-6, 1e-4),
         ];
         for (w, xf, area, dt) in cases {
             let p = PointProblem {
@@ -2357,22 +2355,22 @@ mod tests {
                 area,
                 rho: default_rho(w),
             };
-            let s = solve_point(&p, [1.0, 2.0, 3.0], 1e-10, 30);
+            let s = solve_point(&p, v3(1.0, 2.0, 3.0), 1e-10, 30);
             assert!(s.iterations <= 30);
-            let _ = solve_point(&p, [f64::NAN; 3], 1e-10, 0);
+            let _ = solve_point(&p, V3::repeat(f64::NAN), 1e-10, 0);
         }
         // W = 0 with an open gap and no adhesion: r = 0 at once.
         let p = PointProblem {
-            w_aa: [[0.0; 3]; 3],
-            x_free: [0.0, 0.0, 1e-3],
+            w_aa: M3::zeros(),
+            x_free: v3(0.0, 0.0, 1e-3),
             law: &DRY,
             bond0: BondState::default(),
             dt: 1e-4,
             area: 1e-6,
             rho: 1.0,
         };
-        let s = solve_point(&p, [0.0; 3], 1e-10, 10);
-        assert!(s.converged && s.r() == [0.0; 3]);
+        let s = solve_point(&p, V3::zeros(), 1e-10, 10);
+        assert!(s.converged && s.r() == V3::zeros());
     }
 
     /// Without fatigue, D counts w per unit of β lost and nothing for β gained.
@@ -2436,7 +2434,7 @@ mod tests {
             let damage = p.fatigue_energy * (1.0 + k as f64 * p.w / p.fatigue_energy).ln();
             let bond = BondState {
                 beta: 1.0,
-                ut: [0.0; 2],
+                ut: Vec2::zeros(),
                 damage,
             };
             let xc = p.degraded(damage).critical_opening();
@@ -2444,7 +2442,7 @@ mod tests {
             // grid through x_c.
             let peak = (1..=3000)
                 .map(|i| {
-                    let x = [0.0, 0.0, xc * i as f64 / 1000.0];
+                    let x = v3(0.0, 0.0, xc * i as f64 / 1000.0);
                     -adhesive_response(&p, bond, 1e-3, area, x).force[2]
                 })
                 .fold(0.0, f64::max);

@@ -37,7 +37,7 @@ use super::law::{
 use super::semismooth::{ARMIJO, ETA_DOWN, ETA_MAX, ETA_MIN, ETA_START, ETA_UP};
 use crate::linalg::{metis_dof_ordering, BlockPattern};
 use crate::sparse_lu::OrderedLu;
-use crate::{mat3_from_rows, Mat3};
+use crate::{Mat3, Vec2, Vec3};
 
 type V3 = [f64; 3];
 
@@ -79,28 +79,24 @@ pub fn linearise_point(
     x: V3,
 ) -> PointLinearisation {
     let mu = law.mu.max(0.0);
+    let (r, x) = (Vec3::from(r), Vec3::from(x));
     let (r_adh, k_adh, beta, ut) = match law.adhesive_response(&bond0, dt, area, x) {
-        Some(resp) => {
-            let k = mat3_from_rows(resp.secant_stiffness);
-            (resp.force, k, resp.beta, resp.ut)
-        }
-        None => ([0.0; 3], Mat3::zeros(), 0.0, [0.0; 2]),
+        Some(resp) => (resp.force, resp.secant_stiffness, resp.beta, resp.ut),
+        None => (Vec3::zeros(), Mat3::zeros(), 0.0, Vec2::zeros()),
     };
-    let y: V3 = std::array::from_fn(|k| r[k] - r_adh[k]);
+    let y = r - r_adh;
     let s = law.tangent_scale();
     let (ys, xs) = (unscale(y, s), scale(x, s));
     let r_star = bipotential_trial(ys, xs, mu, rho);
     let (proj, state) = dry_projection(r_star, mu);
     let pj = projection_jacobian(r_star, mu, state);
-    let pj = mat3_from_rows(pj);
     let d = modified_displacement_jacobian(xs, mu);
-    let d = mat3_from_rows(d);
-    let t = Mat3::from_diagonal(&scale([1.0; 3], s).into());
-    let t_inv = Mat3::from_diagonal(&unscale([1.0; 3], s).into());
+    let t = Mat3::from_diagonal(&scale(Vec3::repeat(1.0), s));
+    let t_inv = Mat3::from_diagonal(&unscale(Vec3::repeat(1.0), s));
     let a = t * (Mat3::identity() - pj) * t_inv;
     let b = a * k_adh + t * (rho * pj * d) * t;
     let b_plain = a * k_adh + t * (rho * pj) * t;
-    let phi = scale(std::array::from_fn(|k| ys[k] - proj[k]), s);
+    let phi = scale(ys - proj, s).into();
     PointLinearisation {
         phi,
         a,
@@ -552,7 +548,7 @@ mod tests {
         let rcc = RccParams::new(1.0, 1e6, 5e5, 0.0);
         let bonded = BondState {
             beta: 1.0,
-            ut: [0.0; 2],
+            ut: Vec2::zeros(),
             damage: 0.0,
         };
         let laws = [
@@ -667,7 +663,7 @@ mod tests {
             };
             let bond = BondState {
                 beta: 0.0,
-                ut: [0.0; 2],
+                ut: Vec2::zeros(),
                 damage: 0.0,
             };
             let lin = |p: usize, r: V3, x: V3| linearise_point(&law, bond, 1.0, 1.0, rho[p], r, x);
@@ -683,7 +679,11 @@ mod tests {
                 let defects = pts.iter().zip(&rho).map(|(pt, &rho)| {
                     super::super::law::natural_map_defect(&law, rho, pt.r_dry, pt.x)
                 });
-                defects.flatten().map(|v| v * v).sum::<f64>().sqrt()
+                defects
+                    .flat_map(|d| [d[0], d[1], d[2]])
+                    .map(|v| v * v)
+                    .sum::<f64>()
+                    .sqrt()
             };
             let r0 = vec![[0.0; 3]; m];
             // Once as it is, once with an out-of-balance force m in the displacement part,

@@ -25,6 +25,7 @@ use super::law::{
     PointSolution,
 };
 use crate::system::SystemMatrix;
+use crate::{Mat3, Vec2, Vec3};
 
 /// ρ_α as a multiple of the stiffness K̄ shows at contact point α: each multiplier update
 /// contracts the error by about 1/(1 + this) at an isolated point.
@@ -36,16 +37,16 @@ pub struct AugmentedPoint {
     /// The point's forces, β₁, bond stretch and case at the current displacement.
     pub solution: PointSolution,
     /// −∂r/∂x used in the Newton matrix [N/m], symmetric positive semi-definite.
-    pub stiffness: [[f64; 3]; 3],
+    pub stiffness: Mat3,
     /// Change λ − r̄ a multiplier update would make [N]; zero at a solution.
-    pub defect: [f64; 3],
+    pub defect: Vec3,
     /// Potential of the point's contact forces at x with λ fixed [J]: ∂/∂x = −(r̄ + r̃).
     pub energy: f64,
 }
 
 /// The bi-potential projection P_K(r − ρ x̂) of a dry force `r` [N] at `x` [m]: `r` is a
 /// solution of the dry contact law at `x` exactly when this returns `r` (docs/model.md §5).
-pub fn bipotential_projection(mu: f64, rho: f64, r: [f64; 3], x: [f64; 3]) -> [f64; 3] {
+pub fn bipotential_projection(mu: f64, rho: f64, r: Vec3, x: Vec3) -> Vec3 {
     dry_projection(bipotential_trial(r, x, mu, rho), mu).0
 }
 
@@ -60,22 +61,22 @@ pub fn bipotential_projection(mu: f64, rho: f64, r: [f64; 3], x: [f64; 3]) -> [f
 /// r_n x_n = 0, ‖r_t‖ ≤ μ r_n, and x_t = 0 inside the disk or x_t = −κ r_t (κ ≥ 0) on its
 /// rim: Signorini and Coulomb, the solutions of the bi-potential condition r = P_K(r − ρ x̂)
 /// as well (docs/contact-solver.md).
-pub fn augmented_dry_force(mu: f64, rho: f64, lambda: [f64; 3], x: [f64; 3]) -> DryForce {
+pub fn augmented_dry_force(mu: f64, rho: f64, lambda: Vec3, x: Vec3) -> DryForce {
     let mu = mu.max(0.0);
     let trial_n = lambda[2] - rho * x[2];
     let rn = trial_n.max(0.0);
-    let mut stiffness = [[0.0; 3]; 3];
+    let mut stiffness = Mat3::zeros();
     // At the kink (a closed gap with no force, e.g. a body resting on a surface at the start)
     // the generalised Jacobian may be either 0 or ρ: the contact one predicts better.
     if trial_n >= 0.0 {
-        stiffness[2][2] = rho;
+        stiffness[(2, 2)] = rho;
     }
     let tau = [lambda[0] - rho * x[0], lambda[1] - rho * x[1]];
     let norm_tau = tau[0].hypot(tau[1]);
     let radius = mu * lambda[2].max(0.0);
     let (rt, sliding, tangential_energy) = if norm_tau <= radius {
-        stiffness[0][0] = rho;
-        stiffness[1][1] = rho;
+        stiffness[(0, 0)] = rho;
+        stiffness[(1, 1)] = rho;
         (tau, false, 0.5 * norm_tau * norm_tau)
     } else {
         let t = [tau[0] / norm_tau, tau[1] / norm_tau];
@@ -83,7 +84,7 @@ pub fn augmented_dry_force(mu: f64, rho: f64, lambda: [f64; 3], x: [f64; 3]) -> 
         for a in 0..2 {
             for b in 0..2 {
                 let delta = if a == b { 1.0 } else { 0.0 };
-                stiffness[a][b] = k * (delta - t[a] * t[b]);
+                stiffness[(a, b)] = k * (delta - t[a] * t[b]);
             }
         }
         (
@@ -100,7 +101,7 @@ pub fn augmented_dry_force(mu: f64, rho: f64, lambda: [f64; 3], x: [f64; 3]) -> 
         ContactState::Stick
     };
     DryForce {
-        force: [rt[0], rt[1], rn],
+        force: Vec3::new(rt[0], rt[1], rn),
         state,
         stiffness,
         energy: (0.5 * rn * rn + tangential_energy) / rho,
@@ -111,11 +112,11 @@ pub fn augmented_dry_force(mu: f64, rho: f64, lambda: [f64; 3], x: [f64; 3]) -> 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DryForce {
     /// r̄ in the local frame [N].
-    pub force: [f64; 3],
+    pub force: Vec3,
     /// Apart (r_n = 0), stick (r_t inside the disk) or slide.
     pub state: ContactState,
     /// −∂r̄/∂x [N/m].
-    pub stiffness: [[f64; 3]; 3],
+    pub stiffness: Mat3,
     /// Potential φ with ∂φ/∂x = −r̄ [J].
     pub energy: f64,
 }
@@ -135,8 +136,8 @@ pub fn augmented_point(
     dt: f64,
     area: f64,
     rho: f64,
-    lambda: [f64; 3],
-    x: [f64; 3],
+    lambda: Vec3,
+    x: Vec3,
 ) -> AugmentedPoint {
     let s = law.tangent_scale();
     let dry = if s == 1.0 {
@@ -154,14 +155,10 @@ pub fn augmented_point(
     let (r_dry, state, mut stiffness) = (dry.force, dry.state, dry.stiffness);
     let (beta, ut, r_adh, adhesive_energy) = match law.adhesive_response(&bond0, dt, area, x) {
         Some(resp) => {
-            for (srow, arow) in stiffness.iter_mut().zip(resp.secant_stiffness) {
-                for (s, a) in srow.iter_mut().zip(arow) {
-                    *s += a;
-                }
-            }
+            stiffness += resp.secant_stiffness;
             (resp.beta, resp.ut, resp.force, resp.energy)
         }
-        None => (0.0, [0.0; 2], [0.0; 3], 0.0),
+        None => (0.0, Vec2::zeros(), Vec3::zeros(), 0.0),
     };
     AugmentedPoint {
         solution: PointSolution {
@@ -175,7 +172,7 @@ pub fn augmented_point(
             converged: true,
         },
         stiffness,
-        defect: std::array::from_fn(|k| lambda[k] - r_dry[k]),
+        defect: lambda - r_dry,
         energy: dry.energy + adhesive_energy,
     }
 }
@@ -263,7 +260,7 @@ pub fn add_contact_tangent(
 pub fn defect_norm(evals: &[AugmentedPoint]) -> f64 {
     evals
         .iter()
-        .flat_map(|e| e.defect)
+        .flat_map(|e| e.defect.iter())
         .map(|d| d * d)
         .sum::<f64>()
         .sqrt()
@@ -293,7 +290,7 @@ mod tests {
         let x_free = -3e-4;
         let exact = -k * x_free;
         let law = dry(0.9);
-        let mut lambda = [0.0; 3];
+        let mut lambda = Vec3::zeros();
         let mut errors = Vec::new();
         for _ in 0..4 {
             // In contact r_n = λ_n − ρ x_n, so x_n = x_free + r_n/k gives:
@@ -305,11 +302,11 @@ mod tests {
                 1.0,
                 rho,
                 lambda,
-                [0.0, 0.0, xn],
+                Vec3::new(0.0, 0.0, xn),
             );
             assert_eq!(ev.solution.state, ContactState::Stick);
-            assert_eq!(ev.stiffness[2][2], rho);
-            lambda = augmented_dry_force(law.mu, rho, lambda, [0.0, 0.0, xn]).force;
+            assert_eq!(ev.stiffness[(2, 2)], rho);
+            lambda = augmented_dry_force(law.mu, rho, lambda, Vec3::new(0.0, 0.0, xn)).force;
             errors.push((lambda[2] - exact).abs());
         }
         let rate = k / (k + rho);
@@ -333,20 +330,28 @@ mod tests {
             1e-3,
             1.0,
             rho,
-            [0.0; 3],
-            [1e-3, 0.0, 2e-3],
+            Vec3::zeros(),
+            Vec3::new(1e-3, 0.0, 2e-3),
         );
         assert_eq!(ev.solution.state, ContactState::Apart);
-        assert_eq!(ev.defect, [0.0; 3]);
+        assert_eq!(ev.defect, Vec3::zeros());
         // Stick: closed, no slip, force inside the cone.
-        let lam = [0.1, -0.2, 1.0];
-        let ev = augmented_point(&law, BondState::default(), 1e-3, 1.0, rho, lam, [0.0; 3]);
+        let lam = Vec3::new(0.1, -0.2, 1.0);
+        let ev = augmented_point(
+            &law,
+            BondState::default(),
+            1e-3,
+            1.0,
+            rho,
+            lam,
+            Vec3::zeros(),
+        );
         assert_eq!(ev.solution.state, ContactState::Stick);
-        assert_eq!(ev.defect, [0.0; 3]);
-        assert_eq!(ev.stiffness[0][0], rho);
+        assert_eq!(ev.defect, Vec3::zeros());
+        assert_eq!(ev.stiffness[(0, 0)], rho);
         // Slide: on the cone, opposing the slip, with x_n = 0.
-        let lam = [-0.3, -0.4, 1.0]; // |r_t| = 0.5 = μ r_n
-        let slip = [3e-4, 4e-4, 0.0];
+        let lam = Vec3::new(-0.3, -0.4, 1.0); // |r_t| = 0.5 = μ r_n
+        let slip = Vec3::new(3e-4, 4e-4, 0.0);
         let ev = augmented_point(&law, BondState::default(), 1e-3, 1.0, rho, lam, slip);
         assert_eq!(ev.solution.state, ContactState::Slide);
         let d = ev.defect.iter().map(|v| v.abs()).fold(0.0, f64::max);
@@ -359,7 +364,7 @@ mod tests {
             1.0,
             rho,
             lam,
-            [-3e-4, -4e-4, 0.0],
+            Vec3::new(-3e-4, -4e-4, 0.0),
         );
         assert!(ev.defect.iter().any(|v| v.abs() > 1e-3));
     }
@@ -374,15 +379,15 @@ mod tests {
         };
         let bond0 = BondState {
             beta: 1.0,
-            ut: [1e-7, 0.0],
+            ut: Vec2::new(1e-7, 0.0),
             damage: 0.0,
         };
-        let x = [1e-7, 0.0, 5e-8];
-        let ev = augmented_point(&law, bond0, 1e-4, 2e-6, 1e3, [0.0; 3], x);
+        let x = Vec3::new(1e-7, 0.0, 5e-8);
+        let ev = augmented_point(&law, bond0, 1e-4, 2e-6, 1e3, Vec3::zeros(), x);
         let resp = adhesive_response(&a, bond0, 1e-4, 2e-6, x);
         assert_eq!(ev.solution.r_adh, resp.force);
         assert!(resp.force[2] < 0.0 && resp.force[0] < 0.0);
-        assert_eq!(ev.stiffness[2][2], resp.secant_stiffness[2][2]);
+        assert_eq!(ev.stiffness[(2, 2)], resp.secant_stiffness[(2, 2)]);
         assert_eq!(ev.solution.state, ContactState::Apart);
     }
 }

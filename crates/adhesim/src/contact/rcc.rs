@@ -14,7 +14,7 @@ use super::law::{
     BondState, FrozenSprings, Interface, InterfaceLaw, PairScales, PointSolution,
 };
 use crate::warnings::{cohesive_zone_length, CN_STIFFNESS_RATIO};
-use crate::Vec3;
+use crate::{Vec2, Vec3};
 
 /// The history of the RCC law at a slave node, between steps.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -88,7 +88,7 @@ impl Interface for InterfaceLaw {
         self.adhesion.is_some()
     }
 
-    fn adhesion_at(&self, start: &BondState, dt: f64, area: f64, x: [f64; 3]) -> AdhEval {
+    fn adhesion_at(&self, start: &BondState, dt: f64, area: f64, x: Vec3) -> AdhEval {
         match &self.adhesion {
             Some(a) => rcc_adhesion_at(*start, dt, area, a, x),
             None => AdhEval::default(),
@@ -129,7 +129,7 @@ impl Interface for InterfaceLaw {
             return None;
         }
         Some(FrozenSprings {
-            stiffness: [k * a.ct, k * a.ct2, k * a.cn],
+            stiffness: Vec3::new(k * a.ct, k * a.ct2, k * a.cn),
             stretch: start.ut,
         })
     }
@@ -139,7 +139,7 @@ impl Interface for InterfaceLaw {
         start: &BondState,
         dt: f64,
         area: f64,
-        x: [f64; 3],
+        x: Vec3,
     ) -> Option<AdhesiveResponse> {
         self.adhesion
             .as_ref()
@@ -150,10 +150,10 @@ impl Interface for InterfaceLaw {
         let h = RccHistory::decode(node);
         BondState {
             beta: h.beta,
-            ut: [
+            ut: Vec2::new(
                 Vec3::from(h.ut).dot(&Vec3::from(frame[0])),
                 Vec3::from(h.ut).dot(&Vec3::from(frame[1])),
-            ],
+            ),
             damage: h.damage,
         }
     }

@@ -11,6 +11,7 @@
 
 use super::law::{default_rho, solve_point, BondState, InterfaceLaw, PointProblem};
 use super::natural_map::{natural_map_residual, relative_error};
+use crate::mat3_from_rows;
 
 type M3 = [[f64; 3]; 3];
 
@@ -197,7 +198,7 @@ pub fn error_of(
 /// ρ per point for the bi-potential maps: 1/λ_max of the diagonal block ([`default_rho`]).
 pub fn point_rhos(w: &BlockSparseDelassus) -> Vec<f64> {
     (0..w.points())
-        .map(|p| default_rho(w.diagonal_block(p)))
+        .map(|p| default_rho(mat3_from_rows(w.diagonal_block(p))))
         .collect()
 }
 
@@ -218,15 +219,15 @@ pub fn gauss_seidel_sweep(
             anisotropy: None,
         };
         let problem = PointProblem {
-            w_aa: w.diagonal_block(p),
-            x_free,
+            w_aa: mat3_from_rows(w.diagonal_block(p)),
+            x_free: x_free.into(),
             law: &law,
             bond0: BondState::default(),
             dt: 1.0,
             area: 1.0,
             rho: rho[p],
         };
-        r[p] = solve_point(&problem, r[p], 1e-12, 200).r_dry;
+        r[p] = solve_point(&problem, r[p].into(), 1e-12, 200).r_dry.into();
     }
 }
 

@@ -82,7 +82,8 @@ fn natural_map_rho(
     w.apply(r, q, x);
     let mut theta = 0.0;
     for p in 0..r.len() {
-        let (proj, _) = dry_projection(bipotential_trial(r[p], x[p], mu[p], rho[p]), mu[p]);
+        let trial = bipotential_trial(r[p].into(), x[p].into(), mu[p], rho[p]);
+        let (proj, _) = dry_projection(trial, mu[p]);
         for a in 0..3 {
             f[p][a] = r[p][a] - proj[a];
             theta += 0.5 * f[p][a] * f[p][a];
@@ -173,15 +174,15 @@ fn newton_direction(
     let mut values: Vec<f64> = Vec::with_capacity(9 * w.block_count());
     for p in 0..n {
         let mu_p = mu[p].max(0.0);
-        let r_star = bipotential_trial(r[p], x[p], mu_p, rho[p]);
+        let r_star = bipotential_trial(r[p].into(), x[p].into(), mu_p, rho[p]);
         let (_, case) = dry_projection(r_star, mu_p);
         let jp = projection_jacobian(r_star, mu_p, case);
-        let d = modified_displacement_jacobian(x[p], mu_p);
+        let d = modified_displacement_jacobian(x[p].into(), mu_p);
         // ρ P' D.
         let mut pd: M3 = [[0.0; 3]; 3];
         for a in 0..3 {
             for b in 0..3 {
-                pd[a][b] = rho[p] * (0..3).map(|k| jp[a][k] * d[k][b]).sum::<f64>();
+                pd[a][b] = rho[p] * (0..3).map(|k| jp[(a, k)] * d[(k, b)]).sum::<f64>();
             }
         }
         for (j, wb) in w.row(p) {
@@ -189,7 +190,7 @@ fn newton_direction(
                 for b in 0..3 {
                     let mut v: f64 = (0..3).map(|k| pd[a][k] * wb[k][b]).sum();
                     if j == p {
-                        v += if a == b { 1.0 } else { 0.0 } - jp[a][b] + eta * pd[a][b];
+                        v += if a == b { 1.0 } else { 0.0 } - jp[(a, b)] + eta * pd[a][b];
                     }
                     entries.push(Pair::new(3 * p + a, 3 * j + b));
                     values.push(v);

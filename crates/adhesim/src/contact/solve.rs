@@ -200,10 +200,8 @@ pub fn gauss_seidel(
     let mut r: Vec<[f64; 3]> = r_start.to_vec();
     let mut sols: Vec<Option<PointSolution>> = vec![None; np];
     let mut dry: Vec<[f64; 3]> = dry_start.to_vec();
-    let blocks: Vec<[[f64; 3]; 3]> = (0..np)
-        .map(|p| {
-            std::array::from_fn(|a| std::array::from_fn(|c| del.w[(3 * p + a) * m + 3 * p + c]))
-        })
+    let blocks: Vec<Mat3> = (0..np)
+        .map(|p| Mat3::from_fn(|a, c| del.w[(3 * p + a) * m + 3 * p + c]))
         .collect();
     let rhos: Vec<f64> = blocks.iter().map(|b| default_rho(*b)).collect();
     let mut converged = false;
@@ -230,21 +228,21 @@ pub fn gauss_seidel(
             }
             let pp = PointProblem {
                 w_aa: blocks[p],
-                x_free: xf,
+                x_free: xf.into(),
                 law: &laws[points[p].pair],
                 bond0: bond0[p],
                 dt,
                 area: points[p].area,
                 rho: rhos[p],
             };
-            let sol = solve_point(&pp, dry[p], 1e-12, 200);
+            let sol = solve_point(&pp, dry[p].into(), 1e-12, 200);
             let rn = sol.r();
             for a in 0..3 {
                 change = change.max((rn[a] - r[p][a]).abs());
                 scale = scale.max(rn[a].abs());
             }
-            r[p] = rn;
-            dry[p] = sol.r_dry;
+            r[p] = rn.into();
+            dry[p] = sol.r_dry.into();
             sols[p] = Some(sol);
         }
         if change <= tol * scale || scale == 0.0 {

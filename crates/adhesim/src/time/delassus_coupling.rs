@@ -209,8 +209,8 @@ impl<'a> ContactCoupling<'a> for DelassusCoupling<'a> {
         }
         let clock = Instant::now();
         for (p, ps) in sol.points.iter().enumerate() {
-            self.r_contact[p] = ps.r();
-            self.r_dry[p] = ps.r_dry;
+            self.r_contact[p] = ps.r().into();
+            self.r_dry[p] = ps.r_dry.into();
         }
         let new_force = self.sc.nodal_force(self.r_contact.iter().copied(), u.len());
         let mut dc: Vec<f64> = (0..u.len())

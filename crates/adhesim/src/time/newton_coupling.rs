@@ -7,6 +7,7 @@ use super::attempt::PhaseTimes;
 use super::coupling::{ContactCoupling, Evaluated, Iterate, StepContact};
 use crate::contact::law::{ContactState, PointSolution};
 use crate::contact::newton::{self, augmented_point, AugmentedPoint};
+use crate::rows_of;
 use crate::system::SystemMatrix;
 use std::time::Instant;
 
@@ -86,12 +87,12 @@ impl<'a> NewtonCoupling<'a> {
                     sc.dt,
                     pt.area,
                     sc.rho[p],
-                    self.lambda[p],
-                    x,
+                    self.lambda[p].into(),
+                    x.into(),
                 )
             })
             .collect();
-        let force = sc.nodal_force(evals.iter().map(|e| e.solution.r()), u.len());
+        let force = sc.nodal_force(evals.iter().map(|e| e.solution.r().into()), u.len());
         (evals, force)
     }
 
@@ -147,7 +148,7 @@ impl<'a> ContactCoupling<'a> for NewtonCoupling<'a> {
         // multipliers is reached to a tenth of the change the update would make.
         if it.iter > 1 && merit <= 0.1 * contact_defect {
             for (l, e) in self.lambda.iter_mut().zip(&self.evals) {
-                *l = e.solution.r_dry;
+                *l = e.solution.r_dry.into();
             }
             self.updates += 1;
             (self.evals, self.contact_force) = self.law_at(u);
@@ -170,7 +171,7 @@ impl<'a> ContactCoupling<'a> for NewtonCoupling<'a> {
         if self.sc.is_empty() {
             return;
         }
-        let stiffness: Vec<_> = self.evals.iter().map(|e| e.stiffness).collect();
+        let stiffness: Vec<_> = self.evals.iter().map(|e| rows_of(&e.stiffness)).collect();
         newton::add_contact_tangent(&self.sc.points, &stiffness, system);
     }
 
