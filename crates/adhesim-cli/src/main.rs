@@ -313,14 +313,15 @@ fn load_options(
 }
 
 fn check(path: &Path, opts: &adhesim::scenario::LoadOptions) -> ExitCode {
-    let problem = match adhesim::scenario::load_with(path, opts) {
+    let scenario = match adhesim::scenario::load_with(path, opts) {
         Ok(p) => p,
         Err(e) => return fail_input(e),
     };
-    if let Err(err) = adhesim::time::check_elements(&problem) {
+    let problem = &scenario.problem;
+    if let Err(err) = adhesim::time::check_elements(problem) {
         return fail_input(format!("{}: {err}", path.display()));
     }
-    for w in adhesim::warnings::physical_warnings(&problem) {
+    for w in adhesim::warnings::physical_warnings(problem) {
         eprintln!("warning: {w}");
     }
     let nodes: usize = problem.bodies.iter().map(|b| b.mesh.num_nodes()).sum();
@@ -349,14 +350,14 @@ fn run(
     overwrite: bool,
     quiet: bool,
 ) -> ExitCode {
-    let problem = match adhesim::scenario::load_with(path, opts) {
+    let scenario = match adhesim::scenario::load_with(path, opts) {
         Ok(p) => p,
         Err(e) => return fail_input(e),
     };
     let out = resume.clone().or(out).unwrap_or_else(|| {
         let name = match &opts.variant {
-            Some(v) => format!("{}-{v}", problem.name),
-            None => problem.name.clone(),
+            Some(v) => format!("{}-{v}", scenario.problem.name),
+            None => scenario.problem.name.clone(),
         };
         PathBuf::from("out").join(name)
     });
@@ -381,12 +382,12 @@ fn run(
             "running"
         };
         eprintln!("{verb} {} → {}", path.display(), out.display());
-        for w in adhesim::warnings::physical_warnings(&problem) {
+        for w in adhesim::warnings::physical_warnings(&scenario.problem) {
             progress.message(&format!("warning: {w}"));
         }
     }
     let summary =
-        match adhesim::run::run_with(problem, Some(path), &out, progress.as_mut(), &control) {
+        match adhesim::run::run_with(scenario, Some(path), &out, progress.as_mut(), &control) {
             Ok(s) => s,
             Err(e) => return fail_input(format!("{}: {e}", path.display())),
         };
@@ -621,13 +622,13 @@ fn sweep(path: &Path, r: SweepRequest) -> ExitCode {
         Ok(o) => o,
         Err(e) => return fail_input(e.replace("--set", "--fix")),
     };
-    let problem = match adhesim::scenario::load_with(path, &base) {
+    let scenario = match adhesim::scenario::load_with(path, &base) {
         Ok(p) => p,
         Err(e) => return fail_input(e),
     };
     let out = r
         .out
-        .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-sweep", problem.name)));
+        .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-sweep", scenario.problem.name)));
     let n_cases = plan.cases.len();
     if r.slurm.slurm {
         return slurm_sweep(

@@ -55,14 +55,14 @@ fn load(
     path: &Path,
     variant: Option<String>,
     overrides: &[String],
-) -> PyResult<adhesim::problem::Problem> {
+) -> PyResult<adhesim::scenario::Scenario> {
     let options = load_options(variant, overrides)?;
-    let problem = adhesim::scenario::parse_with(text, path, &options)
+    let scenario = adhesim::scenario::parse_with(text, path, &options)
         .map_err(|e| ScenarioError::new_err(e.to_string()))?;
-    if let Err(err) = adhesim::time::check_elements(&problem) {
+    if let Err(err) = adhesim::time::check_elements(&scenario.problem) {
         return Err(ScenarioError::new_err(format!("{}: {err}", path.display())));
     }
-    Ok(problem)
+    Ok(scenario)
 }
 
 /// The TOML document `text` as JSON text (syntax only: nothing is validated).
@@ -101,8 +101,9 @@ fn check(
     variant: Option<String>,
     overrides: Vec<String>,
 ) -> PyResult<String> {
-    let problem = load(text, &path, variant, &overrides)?;
-    let warnings = adhesim::warnings::physical_warnings(&problem);
+    let scenario = load(text, &path, variant, &overrides)?;
+    let problem = &scenario.problem;
+    let warnings = adhesim::warnings::physical_warnings(problem);
     let info = serde_json::json!({
         "name": problem.name,
         "bodies": problem.bodies.iter().map(|b| b.name.clone()).collect::<Vec<_>>(),
@@ -110,7 +111,7 @@ fn check(
         "cells": problem.bodies.iter().map(|b| b.mesh.num_cells()).sum::<usize>(),
         "t_end": problem.time.t_end,
         "dt": problem.time.dt,
-        "fingerprint": format!("{:016x}", adhesim::checkpoint::fingerprint(&problem)),
+        "fingerprint": format!("{:016x}", adhesim::checkpoint::fingerprint(problem, &scenario.output)),
         "warnings": warnings,
     });
     Ok(info.to_string())
@@ -217,7 +218,7 @@ fn run<'py>(
     from_file: bool,
     stop: Option<StopRequest>,
 ) -> PyResult<(String, Vec<String>)> {
-    let problem = load(text, &path, variant, &overrides)?;
+    let scenario = load(text, &path, variant, &overrides)?;
     let stop = stop.unwrap_or_default().flag;
     let control = RunControl {
         checkpoint_every,
@@ -232,10 +233,10 @@ fn run<'py>(
         error: None,
         messages: Vec::new(),
     };
-    let scenario = from_file.then_some(path.as_path());
+    let scenario_file = from_file.then_some(path.as_path());
     let summary = py
         .allow_threads(|| {
-            adhesim::run::run_with(problem, scenario, &out_dir, &mut progress, &control)
+            adhesim::run::run_with(scenario, scenario_file, &out_dir, &mut progress, &control)
         })
         .map_err(|e| RunError::new_err(format!("{}: {e}", path.display())))?;
     if let Some(e) = progress.error {

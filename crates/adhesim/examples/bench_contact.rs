@@ -597,7 +597,8 @@ fn run_child(cfg: &Config, kind: Kind, n: usize) -> Outcome {
 fn run_size(cfg: &Config, n: usize) -> SizeResult {
     let text = scenario(cfg, n);
     let problem = adhesim::scenario::parse(&text, Path::new("bench_contact.toml"))
-        .unwrap_or_else(|e| fail(&format!("scenario: {e}")));
+        .unwrap_or_else(|e| fail(&format!("scenario: {e}")))
+        .problem;
     let problem = Arc::new(problem);
     let mut setups = Vec::new();
     let mut steps = Vec::new();
@@ -813,7 +814,8 @@ fn subset_delassus(
 fn probe_size(cfg: &Config, n: usize) -> ProbeResult {
     let text = scenario(cfg, n);
     let problem = adhesim::scenario::parse(&text, Path::new("bench_contact.toml"))
-        .unwrap_or_else(|e| fail(&format!("scenario: {e}")));
+        .unwrap_or_else(|e| fail(&format!("scenario: {e}")))
+        .problem;
     let problem = Arc::new(problem);
     let clock = Instant::now();
     let stepper = Stepper::new(problem.clone()).unwrap_or_else(|e| fail(&format!("setup: {e}")));

@@ -21,7 +21,7 @@ use adhesim::element::{element_response, hex8_geometry};
 use adhesim::linalg::{metis_dof_ordering, BlockPattern, SparseCholesky};
 use adhesim::material::{BlatzKo, Hyperelastic};
 use adhesim::mesh::generate;
-use adhesim::problem::{Body, Dirichlet, OutputSettings, Problem, Table, TimeSettings};
+use adhesim::problem::{Body, Dirichlet, Problem, Table, TimeSettings};
 use adhesim::time::Stepper;
 use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::{
@@ -1034,11 +1034,6 @@ fn bench_dynamic(n: usize, steps: usize, threads: usize) -> DynamicResult {
             ..TimeSettings::default()
         },
         contacts: vec![],
-        tracks: vec![],
-        output: OutputSettings {
-            frame_interval: 0.0,
-            ..Default::default()
-        },
     };
     with_threads(threads, || {
         let t0 = Instant::now();

@@ -14,6 +14,7 @@
 //! (see [`crate::output::atomic`]), so there is always one complete checkpoint: the last.
 
 use crate::contact::history::MAX_HISTORY_VALUES;
+use crate::output::settings::OutputSettings;
 use crate::output::FrameProgress;
 use crate::problem::Problem;
 use crate::time::{CachedDelassus, DelassusCache, NodeContact, Snapshot};
@@ -25,8 +26,12 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 
 const MAGIC: &[u8; 8] = b"ADHCKPT\0";
 /// The checkpoint format this version writes.
-pub const FORMAT: u32 = 5;
-/// The previous format, still read: it stored the RCC law's history (β, u_t, D), the only
+pub const FORMAT: u32 = 6;
+/// The previous format, still read: the layout of [`FORMAT`], written by builds whose
+/// fingerprint hashed the output settings as part of the problem (so their fingerprints
+/// differ from this build's for the same scenario).
+const FORMAT_OUTPUT_IN_PROBLEM: u32 = 5;
+/// The format before that, still read: it stored the RCC law's history (β, u_t, D), the only
 /// law then, among each contact node's other values.
 const FORMAT_RCC_ONLY: u32 = 4;
 
@@ -82,12 +87,14 @@ pub enum CheckpointError {
     },
 }
 
-/// A fingerprint of everything that defines `problem` (meshes, materials, loads, contact
-/// pairs, time stepping, tracks, output settings): FNV-1a 64 of its `Debug` form, in which
-/// every number appears in shortest round-trip form.
-pub fn fingerprint(problem: &Problem) -> u64 {
+/// A fingerprint of everything that defines a run: `problem` (meshes, materials, loads,
+/// contact pairs, time stepping) and `output` (tracks, frames, maps, reactions' names):
+/// FNV-1a 64 of their `Debug` forms, in which every number appears in shortest round-trip
+/// form.
+pub fn fingerprint(problem: &Problem, output: &OutputSettings) -> u64 {
     let mut h = Fnv::new();
     let _ = write!(h, "{problem:?}");
+    let _ = write!(h, "{output:?}");
     h.0
 }
 
@@ -137,7 +144,12 @@ impl Checkpoint {
     }
 
     /// Checks that the checkpoint in `dir` was written for `problem` by this version.
-    pub fn check_matches(&self, problem: &Problem, dir: &Path) -> Result<(), CheckpointError> {
+    pub fn check_matches(
+        &self,
+        problem: &Problem,
+        output: &OutputSettings,
+        dir: &Path,
+    ) -> Result<(), CheckpointError> {
         let mismatch = |reason: String| CheckpointError::Mismatch {
             path: Self::path(dir),
             reason,
@@ -150,7 +162,7 @@ impl Checkpoint {
                 self.version
             )));
         }
-        if self.fingerprint != fingerprint(problem) {
+        if self.fingerprint != fingerprint(problem, output) {
             // The fingerprint hashes the problem as this build describes it; the builds that
             // wrote an older format described the same scenario differently, so a mismatch
             // there says nothing about the scenario.
@@ -181,7 +193,7 @@ impl Checkpoint {
         self.encode_as(FORMAT)
     }
 
-    /// [`Checkpoint::encode`] in the file format `format` ([`FORMAT`], or format 4 for the
+    /// [`Checkpoint::encode`] in the file format `format` ([`FORMAT`], or an older one for the
     /// tests that read it).
     fn encode_as(mut self, format: u32) -> Vec<u8> {
         let mut w = Enc(Vec::new());
@@ -211,10 +223,10 @@ impl Checkpoint {
             pos: MAGIC.len(),
         };
         let format = u32::from_le_bytes(r.take(4)?.try_into().unwrap());
-        if format != FORMAT && format != FORMAT_RCC_ONLY {
+        if ![FORMAT, FORMAT_OUTPUT_IN_PROBLEM, FORMAT_RCC_ONLY].contains(&format) {
             return Err(format!(
                 "format {format}, but this version of adhesim reads formats \
-                 {FORMAT_RCC_ONLY} and {FORMAT}"
+                 {FORMAT_RCC_ONLY} to {FORMAT}"
             ));
         }
         let mut checkpoint = Checkpoint {
@@ -598,39 +610,57 @@ mod tests {
                 ..time.clone()
             },
             contacts: vec![],
-            tracks: vec![],
-            output: crate::problem::OutputSettings {
-                frame_interval: 0.1,
-                ..Default::default()
-            },
         };
-        assert_eq!(fingerprint(&problem(1.0)), fingerprint(&problem(1.0)));
+        let output = |frame_interval: f64| OutputSettings {
+            frame_interval,
+            ..Default::default()
+        };
+        let out = output(0.1);
+        assert_eq!(
+            fingerprint(&problem(1.0), &out),
+            fingerprint(&problem(1.0), &out)
+        );
         assert_ne!(
-            fingerprint(&problem(1.0)),
-            fingerprint(&problem(1.0000000000000002))
+            fingerprint(&problem(1.0), &out),
+            fingerprint(&problem(1.0000000000000002), &out)
+        );
+        // What the run writes is part of it too (a resumed run must write the same columns).
+        assert_ne!(
+            fingerprint(&problem(1.0), &out),
+            fingerprint(&problem(1.0), &output(0.2))
         );
         // A checkpoint for another problem: a changed scenario in the current format, an
         // earlier build in the older one (it cannot tell the two apart, so it says so).
         let dir = Path::new("out/p");
+        let refusal = |c: &Checkpoint| {
+            c.check_matches(&problem(1.0), &out, dir)
+                .unwrap_err()
+                .to_string()
+        };
         let current = Checkpoint::decode(&sample().encode()).unwrap();
-        let err = current
-            .check_matches(&problem(1.0), dir)
-            .unwrap_err()
-            .to_string();
+        let err = refusal(&current);
         assert!(err.contains("the scenario differs"), "{err}");
         let older = Checkpoint::decode(&sample().encode_as(FORMAT_RCC_ONLY)).unwrap();
         assert_eq!(older.format, FORMAT_RCC_ONLY);
-        let err = older
-            .check_matches(&problem(1.0), dir)
-            .unwrap_err()
-            .to_string();
+        let err = refusal(&older);
         assert!(
             err.contains("checkpoint format 4 by an earlier build"),
             "{err}"
         );
         assert!(err.contains("out/p/checkpoint.bin"), "{err}");
+        // Format 5 has this layout but hashed the output settings inside the problem.
+        let five = Checkpoint::decode(&sample().encode_as(FORMAT_OUTPUT_IN_PROBLEM)).unwrap();
+        assert!(
+            five.clone().encode() == current.clone().encode(),
+            "same fields"
+        );
+        let err = refusal(&five);
+        assert!(
+            err.contains("checkpoint format 5 by an earlier build"),
+            "{err}"
+        );
         let mut same = older.clone();
-        same.fingerprint = fingerprint(&problem(1.0));
-        assert!(same.check_matches(&problem(1.0), dir).is_ok());
+        same.fingerprint = fingerprint(&problem(1.0), &out);
+        assert!(same.check_matches(&problem(1.0), &out, dir).is_ok());
     }
 }

@@ -150,42 +150,8 @@ impl Default for TimeSettings {
     }
 }
 
-/// A node whose fields are written to the history at every step.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Track {
-    /// Column prefix in history.csv.
-    pub name: String,
-    /// Global node index.
-    pub node: usize,
-}
-
-/// Output settings.
-#[derive(Clone, Debug, PartialEq, Default)]
-pub struct OutputSettings {
-    /// Write a VTU frame every this many seconds of simulated time (0 = every step).
-    pub frame_interval: f64,
-    /// Draw the history figures (PNG) when the run ends.
-    pub figures: bool,
-    /// Maps of contact fields over a pair's slave surface at given times.
-    pub maps: Vec<MapRequest>,
-    /// Name under which the reaction of each entry of [`Problem::dirichlet`] is written to
-    /// the history (same order); an empty name, or an entry beyond the list, is not written.
-    pub boundary_names: Vec<String>,
-}
-
-/// Maps of contact fields over the slave surface of a contact pair, drawn at the first
-/// committed step at or after each requested time.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MapRequest {
-    /// Index of the contact pair.
-    pub pair: usize,
-    /// Contact fields to map (`beta`, `rn`, `rn_adh`, `rt`, `rt_adh`, `gap`, `slip`, ...).
-    pub fields: Vec<String>,
-    /// Times [s], increasing.
-    pub times: Vec<f64>,
-}
-
-/// Everything a run needs.
+/// Everything the stepper needs: the physics of a run (what it writes is
+/// [`crate::output::settings::OutputSettings`]).
 #[derive(Clone, Debug)]
 pub struct Problem {
     /// Name of the run (file stem of outputs).
@@ -202,10 +168,6 @@ pub struct Problem {
     pub time: TimeSettings,
     /// Contact pairs.
     pub contacts: Vec<crate::contact::ContactPair>,
-    /// Tracked nodes.
-    pub tracks: Vec<Track>,
-    /// Output frequency.
-    pub output: OutputSettings,
 }
 
 impl Problem {

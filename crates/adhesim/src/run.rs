@@ -16,7 +16,7 @@ use crate::checkpoint::{fingerprint, Checkpoint, CheckpointError};
 use crate::output::maps::MapObserver;
 use crate::output::plot::PlotError;
 use crate::output::{FrameWriter, HistoryObserver, Observer, StepView};
-use crate::problem::Problem;
+use crate::scenario::Scenario;
 use crate::time::{SetupError, StepReport, Stepper};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -145,16 +145,22 @@ pub enum RunError {
     OutDir(#[from] crate::outdir::OutDirError),
 }
 
-/// Runs `problem`, writing outputs to `out_dir`; returns the summary (also written to
-/// `out_dir/run.json`). A step that cannot be completed ends the run with
-/// [`Outcome::Failed`], not an error.
+/// Runs `scenario` (read from the file `scenario_file`, if any), writing outputs to
+/// `out_dir`; returns the summary (also written to `out_dir/run.json`). A step that cannot be
+/// completed ends the run with [`Outcome::Failed`], not an error.
 pub fn run(
-    problem: Problem,
-    scenario: Option<&Path>,
+    scenario: Scenario,
+    scenario_file: Option<&Path>,
     out_dir: &Path,
     progress: &mut dyn Progress,
 ) -> Result<RunSummary, RunError> {
-    run_with(problem, scenario, out_dir, progress, &RunControl::default())
+    run_with(
+        scenario,
+        scenario_file,
+        out_dir,
+        progress,
+        &RunControl::default(),
+    )
 }
 
 /// [`run`] with checkpoints, stop requests and resuming as `control` asks.
@@ -163,12 +169,13 @@ pub fn run(
 /// problem, cuts history.csv back to the rows up to the checkpoint, keeps the frames up to it
 /// and goes on from there: the outputs end up as those of an uninterrupted run.
 pub fn run_with(
-    problem: Problem,
-    scenario: Option<&Path>,
+    scenario: Scenario,
+    scenario_file: Option<&Path>,
     out_dir: &Path,
     progress: &mut dyn Progress,
     control: &RunControl,
 ) -> Result<RunSummary, RunError> {
+    let Scenario { problem, output } = scenario;
     let start = Instant::now();
     let io_err = |source| RunError::Io {
         dir: out_dir.to_path_buf(),
@@ -182,19 +189,19 @@ pub fn run_with(
     };
     let resume_from = if control.resume {
         let c = Checkpoint::read(out_dir)?;
-        c.check_matches(&problem, out_dir)?;
+        c.check_matches(&problem, &output, out_dir)?;
         Some(c)
     } else {
         std::fs::create_dir_all(out_dir).map_err(io_err)?;
         crate::outdir::prepare_fresh(out_dir, !control.refuse_existing_run)?;
         None
     };
-    let fingerprint = fingerprint(&problem);
+    let fingerprint = fingerprint(&problem, &output);
     let problem = Arc::new(problem);
     let mut stepper = Stepper::new(problem.clone())?;
     let mut summary = RunSummary {
         name: problem.name.clone(),
-        scenario: scenario.map(Path::to_path_buf),
+        scenario: scenario_file.map(Path::to_path_buf),
         version: env!("CARGO_PKG_VERSION").to_string(),
         outcome: Outcome::Running,
         t_reached: 0.0,
@@ -234,26 +241,25 @@ pub fn run_with(
                     crate::output::atomic::remove_stale_temps(&d).map_err(io_err)?;
                 }
             }
-            let frames = FrameWriter::resume(
-                out_dir,
-                &problem.name,
-                problem.output.frame_interval,
-                c.frames,
+            let frames =
+                FrameWriter::resume(out_dir, &problem.name, output.frame_interval, c.frames)
+                    .map_err(io_err)?;
+            let history = HistoryObserver::resume(
+                &out_dir.join("history.csv"),
+                &problem,
+                &output,
+                c.history_rows,
             )
             .map_err(io_err)?;
-            let history =
-                HistoryObserver::resume(&out_dir.join("history.csv"), &problem, c.history_rows)
-                    .map_err(io_err)?;
-            let maps = MapObserver::resume(out_dir, &problem.output.maps, at.t).map_err(io_err)?;
+            let maps = MapObserver::resume(out_dir, &output.maps, at.t).map_err(io_err)?;
             (frames, history, maps)
         }
         None => {
             let mut frames =
-                FrameWriter::new(out_dir, &problem.name, problem.output.frame_interval)
-                    .map_err(io_err)?;
-            let mut history =
-                HistoryObserver::new(&out_dir.join("history.csv"), &problem).map_err(io_err)?;
-            let mut maps = MapObserver::new(out_dir, &problem.output.maps).map_err(io_err)?;
+                FrameWriter::new(out_dir, &problem.name, output.frame_interval).map_err(io_err)?;
+            let mut history = HistoryObserver::new(&out_dir.join("history.csv"), &problem, &output)
+                .map_err(io_err)?;
+            let mut maps = MapObserver::new(out_dir, &output.maps).map_err(io_err)?;
             let initial = StepReport {
                 internal: 0.0,
                 kinetic: stepper.kinetic_energy(&stepper.state.v),
@@ -355,7 +361,7 @@ pub fn run_with(
         }
         Ok(())
     })();
-    if result.is_ok() && problem.output.figures && summary.outcome != Outcome::Interrupted {
+    if result.is_ok() && output.figures && summary.outcome != Outcome::Interrupted {
         // Figures are a convenience drawn from the files just written: a failure to draw
         // them is reported, and does not change how the run ended.
         if let Err(e) = draw_figures(out_dir) {

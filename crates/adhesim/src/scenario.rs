@@ -1,4 +1,5 @@
-//! Scenario files (TOML) parsed and validated into a [`Problem`].
+//! Scenario files (TOML) parsed and validated into a [`Scenario`]: the [`Problem`] the stepper
+//! solves and the [`OutputSettings`] of what the run writes.
 //!
 //! Parsing (serde) rejects unknown keys and wrong types with the line and column; validation
 //! then checks values (positive moduli, time step, existing node sets, ...) and names the key
@@ -11,9 +12,9 @@ use crate::material::{self, Hyperelastic};
 use crate::mesh::generate::{self, FlatSide};
 use crate::mesh::{gmsh, quality};
 use crate::mesh::{Face, Mesh};
+use crate::output::settings::{MapRequest, OutputSettings, Track};
 use crate::problem::{
-    Body, ContactSolver, Dirichlet, MapRequest, NodalLoad, OutputSettings, Problem, Rotation,
-    Table, TimeSettings, Track,
+    Body, ContactSolver, Dirichlet, NodalLoad, Problem, Rotation, Table, TimeSettings,
 };
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -378,13 +379,22 @@ pub struct LoadOptions {
     pub overrides: Vec<Override>,
 }
 
+/// A validated scenario: the physics of the run and what it writes, apart.
+#[derive(Clone, Debug)]
+pub struct Scenario {
+    /// What the stepper solves.
+    pub problem: Problem,
+    /// What the run writes besides the history's own columns.
+    pub output: OutputSettings,
+}
+
 /// Reads and validates a scenario file.
-pub fn load(path: &Path) -> Result<Problem, ScenarioError> {
+pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
     load_with(path, &LoadOptions::default())
 }
 
 /// Reads a scenario file, applies a variant and overrides, and validates it.
-pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Problem, ScenarioError> {
+pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scenario, ScenarioError> {
     let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
         file: path.to_path_buf(),
         message: format!("cannot read the scenario file: {e}"),
@@ -394,7 +404,7 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Problem, Scenario
 
 /// Parses and validates scenario text; `path` names the file in errors and sets the default
 /// run name.
-pub fn parse(text: &str, path: &Path) -> Result<Problem, ScenarioError> {
+pub fn parse(text: &str, path: &Path) -> Result<Scenario, ScenarioError> {
     parse_with(text, path, &LoadOptions::default())
 }
 
@@ -403,7 +413,7 @@ pub fn parse_with(
     text: &str,
     path: &Path,
     options: &LoadOptions,
-) -> Result<Problem, ScenarioError> {
+) -> Result<Scenario, ScenarioError> {
     let ctx = Ctx { file: path };
     let hint = "(see docs/scenario.md for the valid keys and types)";
     let mut doc: toml::Table = toml::from_str(text)
@@ -452,7 +462,7 @@ pub fn parse_with(
     validate(raw, &ctx)
 }
 
-fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
+fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Scenario, ScenarioError> {
     let name = raw.name.clone().unwrap_or_else(|| {
         ctx.file
             .file_stem()
@@ -809,20 +819,22 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Problem, ScenarioError> {
         });
     }
     let figures = raw.output.as_ref().and_then(|o| o.figures).unwrap_or(true);
-    Ok(Problem {
-        name,
-        bodies,
-        dirichlet,
-        loads,
-        gravity,
-        time,
-        contacts,
-        tracks,
+    Ok(Scenario {
+        problem: Problem {
+            name,
+            bodies,
+            dirichlet,
+            loads,
+            gravity,
+            time,
+            contacts,
+        },
         output: OutputSettings {
             frame_interval,
             figures,
             maps,
             boundary_names,
+            tracks,
         },
     })
 }

@@ -281,7 +281,7 @@ impl SweepPlan {
     }
 
     /// Loads every case's problem; the first invalid case stops it.
-    pub fn load_cases(&self) -> Result<Vec<crate::problem::Problem>, SweepError> {
+    pub fn load_cases(&self) -> Result<Vec<crate::scenario::Scenario>, SweepError> {
         self.cases
             .iter()
             .map(|c| {
@@ -479,7 +479,7 @@ pub fn run_sweep(
     let start = std::time::Instant::now();
     // Each case is loaded once: here, so that a bad value stops the sweep before anything
     // runs, and the worker that runs it takes it from its slot.
-    let problems: Vec<Mutex<Option<crate::problem::Problem>>> = plan
+    let problems: Vec<Mutex<Option<crate::scenario::Scenario>>> = plan
         .load_cases()?
         .into_iter()
         .map(|p| Mutex::new(Some(p)))
@@ -552,7 +552,7 @@ pub fn run_sweep(
 fn run_case(
     scenario: &Path,
     dir: &Path,
-    problem: crate::problem::Problem,
+    problem: crate::scenario::Scenario,
     options: &SweepOptions,
 ) -> Result<RunSummary, String> {
     let pool = rayon::ThreadPoolBuilder::new()

@@ -376,7 +376,9 @@ mod tests {
     use std::path::Path;
 
     fn problem(text: &str) -> Problem {
-        crate::scenario::parse(text, Path::new("test.toml")).unwrap()
+        crate::scenario::parse(text, Path::new("test.toml"))
+            .unwrap()
+            .problem
     }
 
     const LAYER: &str = r#"

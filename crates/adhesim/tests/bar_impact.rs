@@ -100,8 +100,9 @@ detection_distance = 1e-3
         dt_min = dt / 64.0,
         v = -V0
     );
-    let problem =
-        adhesim::scenario::parse(&text, Path::new("bar_impact.toml")).expect("valid scenario");
+    let problem = adhesim::scenario::parse(&text, Path::new("bar_impact.toml"))
+        .expect("valid scenario")
+        .problem;
     let clock = Instant::now();
     let mut s = Stepper::new(Arc::new(problem)).expect("valid problem");
     // Momentum and mass from the solver's own mass matrix: with e the unit y translation,

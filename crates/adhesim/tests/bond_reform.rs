@@ -36,7 +36,9 @@ detection_distance = 5e-4
 
 #[test]
 fn bond_breaks_and_reforms_with_the_same_pull_off_force() {
-    let problem = adhesim::scenario::parse(SCENARIO, Path::new("bond_reform.toml")).unwrap();
+    let problem = adhesim::scenario::parse(SCENARIO, Path::new("bond_reform.toml"))
+        .unwrap()
+        .problem;
     let centre = problem.contacts[0]
         .slave_nodes
         .iter()

@@ -4,7 +4,7 @@
 use adhesim::fbar::Formulation;
 use adhesim::material::{Hyperelastic, UncoupledNeoHookean};
 use adhesim::mesh::{generate, Mesh};
-use adhesim::problem::{Body, Dirichlet, NodalLoad, OutputSettings, Problem, Table, TimeSettings};
+use adhesim::problem::{Body, Dirichlet, NodalLoad, Problem, Table, TimeSettings};
 use adhesim::time::Stepper;
 use std::sync::Arc;
 
@@ -60,11 +60,6 @@ pub fn one_body(
         gravity: Default::default(),
         time,
         contacts: vec![],
-        tracks: vec![],
-        output: OutputSettings {
-            frame_interval: 0.0,
-            ..Default::default()
-        },
     }
 }
 

@@ -25,7 +25,9 @@ fn load(file: &str, variant: Option<&str>, overrides: &[&str]) -> Problem {
             .map(|s| Override::parse(s).unwrap())
             .collect(),
     };
-    load_with(&scenario(file), &opts).unwrap_or_else(|e| panic!("{e}"))
+    load_with(&scenario(file), &opts)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .problem
 }
 
 /// Per committed step: time and the committed contact state of every pair.
@@ -269,7 +271,9 @@ detection_distance = 1e-3
 "#;
     use adhesim::problem::ContactSolver;
     for solver in [ContactSolver::Newton, ContactSolver::Semismooth] {
-        let mut problem = adhesim::scenario::parse(text, Path::new("drag.toml")).unwrap();
+        let mut problem = adhesim::scenario::parse(text, Path::new("drag.toml"))
+            .unwrap()
+            .problem;
         problem.time.contact_solver = solver;
         dissipates(run(problem), solver);
     }

@@ -28,8 +28,9 @@ friction = {mu}
 detection_distance = 1e-3
 "#
     );
-    let problem =
-        adhesim::scenario::parse(&text, Path::new("coulomb.toml")).expect("valid scenario");
+    let problem = adhesim::scenario::parse(&text, Path::new("coulomb.toml"))
+        .expect("valid scenario")
+        .problem;
     let nodes = (0..problem.bodies[0].mesh.num_nodes()).collect();
     (Stepper::new(Arc::new(problem)).unwrap(), nodes)
 }

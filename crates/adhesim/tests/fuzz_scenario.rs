@@ -256,9 +256,9 @@ fn exercise(seed: usize, mutations: &[Mutation], variant: bool) {
         _ => parse(&text, &s.path),
     };
     match result {
-        Ok(problem) => {
+        Ok(scenario) => {
             ACCEPTED.fetch_add(1, Ordering::Relaxed);
-            let _ = adhesim::warnings::physical_warnings(&problem);
+            let _ = adhesim::warnings::physical_warnings(&scenario.problem);
         }
         Err(e) => {
             let msg = e.to_string();

@@ -143,7 +143,7 @@ fn shipped_mesh_counts_sets_and_volumes() {
 #[test]
 fn shipped_scenario_loads_and_presses_the_layer() {
     let path = root().join("scenarios/gmsh/hemisphere_on_layer.toml");
-    let problem = adhesim::scenario::load(&path).unwrap();
+    let problem = adhesim::scenario::load(&path).unwrap().problem;
     assert_eq!(problem.bodies.len(), 2);
     // Scaled from millimetres: the hemisphere's flat top is at y = 10.1 mm.
     let top = problem.bodies[0]
@@ -218,7 +218,9 @@ fn scenario_errors_name_the_key_and_the_file() {
     assert!(e.contains("`body[0].mesh.scale`"), "{e}");
     let e = scenario_error(&with(r#", generator = "block""#), &dir);
     assert!(e.contains("not both"), "{e}");
-    adhesim::scenario::parse(&with(""), &dir.join("s.toml")).unwrap();
+    adhesim::scenario::parse(&with(""), &dir.join("s.toml"))
+        .unwrap()
+        .problem;
 
     // An inverted tetrahedron (two nodes swapped) is reported with its Gmsh tag before
     // anything runs.

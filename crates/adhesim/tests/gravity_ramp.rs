@@ -46,8 +46,9 @@ fix = ["x", "y", "z"]
 
 /// Mean vertical displacement of the free end face [m].
 fn tip_deflection(nx: usize, ny: usize) -> f64 {
-    let problem =
-        adhesim::scenario::parse(&cantilever(nx, ny), Path::new("sag.toml")).expect("valid");
+    let problem = adhesim::scenario::parse(&cantilever(nx, ny), Path::new("sag.toml"))
+        .expect("valid")
+        .problem;
     let right = problem.bodies[0].mesh.node_sets["right"].clone();
     let mut s = Stepper::new(Arc::new(problem)).unwrap();
     let mut steps = 0;
@@ -133,14 +134,14 @@ fn run_text(text: &str, tag: &str) -> Outcome {
     run_problem(problem, tag)
 }
 
-fn run_problem(problem: adhesim::problem::Problem, tag: &str) -> Outcome {
+fn run_problem(problem: adhesim::scenario::Scenario, tag: &str) -> Outcome {
     let out = std::env::temp_dir().join(format!("adhesim-test-gravity-{tag}"));
     let _ = std::fs::remove_dir_all(&out);
     run(problem, None, &out, &mut Silent).unwrap().outcome
 }
 
 /// scenarios/cantilever-sag.toml, with `overrides` (`KEY=VALUE`).
-fn shipped_sag(overrides: &[&str]) -> adhesim::problem::Problem {
+fn shipped_sag(overrides: &[&str]) -> adhesim::scenario::Scenario {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/cantilever-sag.toml");
     let options = adhesim::scenario::LoadOptions {
         variant: None,
@@ -175,9 +176,9 @@ fn soft_sag_applied_at_once_fails_naming_the_increment_and_ramped_completes() {
     assert!(!message.contains("unconstrained") && !message.contains("must be held"));
     // As shipped (the ramp the message names), it completes without a cut-back and the tip
     // comes down by a large fraction of the length.
-    let problem = shipped_sag(&["output.figures=false"]);
-    let tip = problem.tracks[0].node;
-    let mut s = Stepper::new(Arc::new(problem)).unwrap();
+    let scenario = shipped_sag(&["output.figures=false"]);
+    let tip = scenario.output.tracks[0].node;
+    let mut s = Stepper::new(Arc::new(scenario.problem)).unwrap();
     while !s.finished() {
         let r = s.step().expect("the ramped sag converges");
         assert_eq!(r.cutbacks, 0);

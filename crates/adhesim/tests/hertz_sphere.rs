@@ -31,9 +31,7 @@ use adhesim::contact::{ContactPair, InterfaceLaw, Master, RigidMotion, RigidShap
 use adhesim::fbar::Formulation;
 use adhesim::material::{BlatzKo, Hyperelastic, UncoupledNeoHookean};
 use adhesim::mesh::{Face, Mesh};
-use adhesim::problem::{
-    Body, ContactSolver, Dirichlet, OutputSettings, Problem, Table, TimeSettings,
-};
+use adhesim::problem::{Body, ContactSolver, Dirichlet, Problem, Table, TimeSettings};
 use adhesim::time::Stepper;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -303,11 +301,6 @@ fn indent_on(
             slave_quads: vec![],
             thickness_twins: vec![],
         }],
-        tracks: vec![],
-        output: OutputSettings {
-            frame_interval: 0.0,
-            ..Default::default()
-        },
     };
     let dofs = 3 * mesh.num_nodes();
     let clock = Instant::now();

@@ -30,7 +30,9 @@ fix = ["x", "y", "z"]
 #[test]
 fn integer_keys_take_expressions() {
     let text = scenario(r#"["= nx", 2, "= nx / 2"]"#);
-    let p = adhesim::scenario::parse(&text, Path::new("ints.toml")).unwrap();
+    let p = adhesim::scenario::parse(&text, Path::new("ints.toml"))
+        .unwrap()
+        .problem;
     let mesh = &p.bodies[0].mesh;
     // 4 × 2 × 2 hexahedra on 5 × 3 × 3 nodes.
     assert_eq!(mesh.hexes().len(), 16);

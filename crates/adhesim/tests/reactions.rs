@@ -150,7 +150,7 @@ fn twist_reaction_moment_balances_the_contact_moment() {
         variant: Some("coarse".into()),
         overrides: vec![],
     };
-    let mut problem = load_with(&path, &opts).unwrap();
+    let mut problem = load_with(&path, &opts).unwrap().problem;
     // 1 ms of twisting after the 5 ms press.
     problem.time.t_end = 6e-3;
     let block = &problem.bodies[0].mesh;

@@ -5,13 +5,13 @@
 use adhesim::checkpoint::{Checkpoint, CheckpointError};
 use adhesim::contact::RccHistory;
 use adhesim::output::csv::read_history;
-use adhesim::problem::Problem;
 use adhesim::run::{run_with, Outcome, RunControl, RunError, Silent};
+use adhesim::scenario::Scenario;
 use std::path::{Path, PathBuf};
 
 /// The shipped indentation scenario, coarsened and cut to its loading phase (1 s, 50 steps):
 /// contact from the first step, bonds forming (β → 1) at the centre and growing outwards.
-fn problem(w: f64) -> Problem {
+fn problem(w: f64) -> Scenario {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/indentation.toml");
     let text = std::fs::read_to_string(&path)
         .unwrap()

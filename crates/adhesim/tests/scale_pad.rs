@@ -84,7 +84,7 @@ fn mesh_counts_take_whole_expressions_only() {
         variant: None,
         overrides: vec![],
     };
-    let problem = load_with(&scenario(), &options).unwrap();
+    let problem = load_with(&scenario(), &options).unwrap().problem;
     assert_eq!(problem.bodies[0].mesh.num_cells(), 9 * 4 * 9);
     // A count that is not whole is refused, naming the value.
     let options = LoadOptions {

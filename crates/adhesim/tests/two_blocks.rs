@@ -43,7 +43,9 @@ detection_distance = 1e-3
 
 #[test]
 fn pressed_blocks_balance_forces_and_share_a_symmetric_pressure() {
-    let problem = adhesim::scenario::parse(SCENARIO, Path::new("two_blocks.toml")).unwrap();
+    let problem = adhesim::scenario::parse(SCENARIO, Path::new("two_blocks.toml"))
+        .unwrap()
+        .problem;
     let lower = &problem.bodies[0].mesh;
     let upper = &problem.bodies[1].mesh;
     let off = lower.num_nodes();

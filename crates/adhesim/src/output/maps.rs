@@ -13,7 +13,7 @@ use super::plot::{draw_scalar_map_with, ColorMap, PlotError, ScalarMap, ScalarVa
 use super::{contact_node_fields, contact_node_values, Observer, StepView, CONTACT_NODE_FIELDS};
 use crate::contact::history::{self, FieldKind, HistoryField};
 use crate::contact::Interface;
-use crate::problem::MapRequest;
+use crate::output::settings::MapRequest;
 use std::collections::BTreeMap;
 use std::io;
 use std::path::{Path, PathBuf};

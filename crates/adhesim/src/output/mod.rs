@@ -6,6 +6,7 @@ pub mod csv;
 pub mod figures;
 pub mod maps;
 pub mod plot;
+pub mod settings;
 pub mod vtk;
 
 use crate::assembly::Discretisation;
@@ -14,6 +15,7 @@ use crate::contact::{Interface, Master, RigidShape};
 use crate::element::von_mises;
 use crate::problem::{Dirichlet, Problem};
 use crate::time::{NodeContact, State, StepReport};
+use settings::OutputSettings;
 use std::io;
 use std::path::{Path, PathBuf};
 
@@ -469,10 +471,12 @@ fn history_columns_of(
 /// Writes `history.csv`: one row per committed step.
 pub struct HistoryObserver {
     writer: csv::HistoryWriter,
+    /// The reactions' names and the tracked nodes.
+    settings: OutputSettings,
 }
 
-/// Column names of the history for a problem.
-pub fn history_columns(problem: &Problem) -> Vec<String> {
+/// Column names of the history for a problem with output settings `output`.
+pub fn history_columns(problem: &Problem, output: &OutputSettings) -> Vec<String> {
     let mut c: Vec<String> = [
         "t",
         "step",
@@ -505,7 +509,7 @@ pub fn history_columns(problem: &Problem) -> Vec<String> {
             c.push(format!("{}.{f}", pair.name));
         }
     }
-    for (name, d) in reported_boundaries(problem) {
+    for (name, d) in reported_boundaries(problem, output) {
         for f in REACTION_FIELDS {
             c.push(format!("{name}.{f}"));
         }
@@ -524,7 +528,7 @@ pub fn history_columns(problem: &Problem) -> Vec<String> {
             ));
         }
     }
-    for tr in &problem.tracks {
+    for tr in &output.tracks {
         for f in ["ux", "uy", "uz", "vx", "vy", "vz"] {
             c.push(format!("{}.{f}", tr.name));
         }
@@ -596,9 +600,11 @@ pub fn pair_totals(nodes: &[NodeContact]) -> [f64; 14] {
 pub const REACTION_FIELDS: [&str; 6] = ["Fx", "Fy", "Fz", "Mx", "My", "Mz"];
 
 /// The boundaries whose reactions are written, with their names.
-fn reported_boundaries(problem: &Problem) -> impl Iterator<Item = (&str, &Dirichlet)> {
-    problem
-        .output
+fn reported_boundaries<'a>(
+    problem: &'a Problem,
+    output: &'a OutputSettings,
+) -> impl Iterator<Item = (&'a str, &'a Dirichlet)> {
+    output
         .boundary_names
         .iter()
         .zip(&problem.dirichlet)
@@ -758,19 +764,26 @@ fn track_contacts(problem: &Problem, node: usize) -> Vec<(usize, usize)> {
 }
 
 impl HistoryObserver {
-    /// Creates `path` with the header for `problem`.
-    pub fn new(path: &Path, problem: &Problem) -> io::Result<Self> {
+    /// Creates `path` with the header for `problem` and `output`.
+    pub fn new(path: &Path, problem: &Problem, output: &OutputSettings) -> io::Result<Self> {
         Ok(HistoryObserver {
-            writer: csv::HistoryWriter::create(path, &history_columns(problem))?,
+            writer: csv::HistoryWriter::create(path, &history_columns(problem, output))?,
+            settings: output.clone(),
         })
     }
 }
 
 impl HistoryObserver {
     /// Continues `path` after its first `rows` rows (see [`csv::HistoryWriter::reopen`]).
-    pub fn resume(path: &Path, problem: &Problem, rows: u64) -> io::Result<Self> {
+    pub fn resume(
+        path: &Path,
+        problem: &Problem,
+        output: &OutputSettings,
+        rows: u64,
+    ) -> io::Result<Self> {
         Ok(HistoryObserver {
-            writer: csv::HistoryWriter::reopen(path, &history_columns(problem), rows)?,
+            writer: csv::HistoryWriter::reopen(path, &history_columns(problem, output), rows)?,
+            settings: output.clone(),
         })
     }
 
@@ -808,7 +821,7 @@ impl Observer for HistoryObserver {
         let u = &view.state.u;
         let t = view.state.t;
         let current = |n: usize| -> [f64; 3] { std::array::from_fn(|k| x[n][k] + u[3 * n + k]) };
-        for (_, d) in reported_boundaries(view.problem) {
+        for (_, d) in reported_boundaries(view.problem, &self.settings) {
             let about = centroid(d.nodes.iter().map(|&n| x[n]));
             let (force, moment) = resultant_and_moment(
                 d.nodes.iter().map(|&n| {
@@ -850,7 +863,7 @@ impl Observer for HistoryObserver {
                 }
             }
         }
-        for tr in &view.problem.tracks {
+        for tr in &self.settings.tracks {
             let n = tr.node;
             row.extend_from_slice(&view.state.u[3 * n..3 * n + 3]);
             row.extend_from_slice(&view.state.v[3 * n..3 * n + 3]);

@@ -184,7 +184,9 @@ fix = ["x", "y", "z"]
 {contact}
 "#
         );
-        let problem = crate::scenario::parse(&text, std::path::Path::new("ties.toml")).unwrap();
+        let problem = crate::scenario::parse(&text, std::path::Path::new("ties.toml"))
+            .unwrap()
+            .problem;
         let n: usize = problem.bodies.iter().map(|b| b.mesh.num_nodes()).sum();
         let fixed = Constraints::new(&problem.dirichlet, 3 * n);
         let rep = thickness_ties(&problem, fixed.mask());
