@@ -187,16 +187,16 @@ pub fn run_with(
     } else {
         Some(crate::outdir::lock(out_dir)?)
     };
+    let fingerprint = fingerprint(&problem, &output);
     let resume_from = if control.resume {
         let c = Checkpoint::read(out_dir)?;
-        c.check_matches(&problem, &output, out_dir)?;
+        c.check_matches(fingerprint, out_dir)?;
         Some(c)
     } else {
         std::fs::create_dir_all(out_dir).map_err(io_err)?;
         crate::outdir::prepare_fresh(out_dir, !control.refuse_existing_run)?;
         None
     };
-    let fingerprint = fingerprint(&problem, &output);
     let problem = Arc::new(problem);
     let mut stepper = Stepper::new(problem.clone())?;
     let mut summary = RunSummary {

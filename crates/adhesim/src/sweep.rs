@@ -280,7 +280,7 @@ impl SweepPlan {
         }
     }
 
-    /// Loads every case's problem; the first invalid case stops it.
+    /// Loads every case's scenario; the first invalid case stops it.
     pub fn load_cases(&self) -> Result<Vec<crate::scenario::Scenario>, SweepError> {
         self.cases
             .iter()
@@ -479,7 +479,7 @@ pub fn run_sweep(
     let start = std::time::Instant::now();
     // Each case is loaded once: here, so that a bad value stops the sweep before anything
     // runs, and the worker that runs it takes it from its slot.
-    let problems: Vec<Mutex<Option<crate::scenario::Scenario>>> = plan
+    let loaded: Vec<Mutex<Option<crate::scenario::Scenario>>> = plan
         .load_cases()?
         .into_iter()
         .map(|p| Mutex::new(Some(p)))
@@ -523,9 +523,9 @@ pub fn run_sweep(
                     }
                 }
                 progress.started(case, total);
-                let problem = problems[i].lock().ok().and_then(|mut p| p.take());
-                let result = match problem {
-                    Some(problem) => run_case(&plan.scenario, &dir, problem, options),
+                let scenario = loaded[i].lock().ok().and_then(|mut p| p.take());
+                let result = match scenario {
+                    Some(scenario) => run_case(&plan.scenario, &dir, scenario, options),
                     None => Err("the case's scenario is not available".into()),
                 };
                 progress.finished(case, total, &result);
@@ -550,9 +550,9 @@ pub fn run_sweep(
 /// Runs one case into `dir`: resumed from its checkpoint when the sweep is resumed and
 /// there is one, otherwise from the start.
 fn run_case(
-    scenario: &Path,
+    scenario_file: &Path,
     dir: &Path,
-    problem: crate::scenario::Scenario,
+    scenario: crate::scenario::Scenario,
     options: &SweepOptions,
 ) -> Result<RunSummary, String> {
     let pool = rayon::ThreadPoolBuilder::new()
@@ -569,7 +569,7 @@ fn run_case(
         // before its first one); a new sweep only writes over a case with --overwrite.
         refuse_existing_run: !(options.resume || options.overwrite),
     };
-    pool.install(|| crate::run::run_with(problem, Some(scenario), dir, &mut Silent, &control))
+    pool.install(|| crate::run::run_with(scenario, Some(scenario_file), dir, &mut Silent, &control))
         .map_err(|e| e.to_string())
 }
 

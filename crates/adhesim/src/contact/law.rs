@@ -1367,19 +1367,9 @@ mod tests {
 
     use crate::mat3_from_rows;
 
-    /// A force or displacement in local components.
-    type V3 = Vec3;
-    /// A 3×3 block (W, stiffness, Jacobian).
-    type M3 = Mat3;
-
     /// A local vector from its components.
-    fn v3(a: f64, b: f64, c: f64) -> V3 {
+    fn v3(a: f64, b: f64, c: f64) -> Vec3 {
         Vec3::new(a, b, c)
-    }
-
-    /// A 3×3 block from its rows.
-    fn m3(rows: [[f64; 3]; 3]) -> M3 {
-        mat3_from_rows(rows)
     }
 
     /// Deterministic generator for randomised tests (splitmix64).
@@ -1400,7 +1390,7 @@ mod tests {
         }
 
         /// Random symmetric positive definite matrix with eigenvalues in [lo, hi].
-        fn spd(&mut self, lo: f64, hi: f64) -> M3 {
+        fn spd(&mut self, lo: f64, hi: f64) -> Mat3 {
             let mut q = [Vec3::zeros(); 3];
             for row in q.iter_mut() {
                 for v in row.iter_mut() {
@@ -1417,22 +1407,21 @@ mod tests {
                 q[i] /= n;
             }
             let l = [lo, self.uniform(lo, hi), hi];
-            M3::from_fn(|i, j| (0..3).map(|k| q[k][i] * l[k] * q[k][j]).sum())
+            Mat3::from_fn(|i, j| (0..3).map(|k| q[k][i] * l[k] * q[k][j]).sum())
         }
     }
 
-    fn diag(a: f64, b: f64, c: f64) -> M3 {
-        m3([[a, 0.0, 0.0], [0.0, b, 0.0], [0.0, 0.0, c]])
+    fn diag(a: f64, b: f64, c: f64) -> Mat3 {
+        Mat3::from_diagonal(&v3(a, b, c))
     }
 
     fn rel(a: f64, b: f64) -> f64 {
         (a - b).abs() / b.abs().max(f64::MIN_POSITIVE)
     }
 
-    fn assert_vec_close(a: V3, b: V3, tol: f64) {
-        let (va, vb) = (Vec3::from(a), Vec3::from(b));
-        let s = va.norm().max(vb.norm()).max(f64::MIN_POSITIVE);
-        assert!((va - vb).norm() <= tol * s, "{a:?} vs {b:?} (tol {tol})");
+    fn assert_vec_close(a: Vec3, b: Vec3, tol: f64) {
+        let s = a.norm().max(b.norm()).max(f64::MIN_POSITIVE);
+        assert!((a - b).norm() <= tol * s, "{a:?} vs {b:?} (tol {tol})");
     }
 
     const DRY: InterfaceLaw = InterfaceLaw {
@@ -1446,7 +1435,12 @@ mod tests {
         RccParams::new(20.0, 2e9, 2e9, 0.1)
     }
 
-    fn problem<'a>(law: &'a InterfaceLaw, w: M3, x_free: V3, bond0: BondState) -> PointProblem<'a> {
+    fn problem<'a>(
+        law: &'a InterfaceLaw,
+        w: Mat3,
+        x_free: Vec3,
+        bond0: BondState,
+    ) -> PointProblem<'a> {
         PointProblem {
             w_aa: w,
             x_free,
@@ -1461,13 +1455,13 @@ mod tests {
     /// Independent check of a point solution against the laws of docs/model.md §5: x = x_free + W r,
     /// r̄ ∈ K_μ, Signorini complementarity, Coulomb sliding rule, and the RCC part.
     fn check_solution(p: &PointProblem, s: &PointSolution, tol: f64) {
-        let r = Vec3::from(s.r());
+        let r = s.r();
         let (w, x_free) = (p.w_aa, p.x_free);
         let x = x_free + w * r;
         let xs = x_free.norm().max(x.norm()).max(f64::MIN_POSITIVE);
-        let parts = xs + (w * Vec3::from(s.r_dry)).norm() + (w * Vec3::from(s.r_adh)).norm();
+        let parts = xs + (w * s.r_dry).norm() + (w * s.r_adh).norm();
         assert!(
-            (x - Vec3::from(s.x)).norm() <= 1e-12 * parts,
+            (x - s.x).norm() <= 1e-12 * parts,
             "x = x_free + W r: {x:?} vs {:?} ({s:?}, {p:?})",
             s.x
         );
@@ -1479,7 +1473,7 @@ mod tests {
         let xt = x[0].hypot(x[1]);
         match s.state {
             ContactState::Apart => {
-                assert_eq!(rd, V3::zeros());
+                assert_eq!(rd, Vec3::zeros());
                 assert!(x[2] >= -tol * xs, "apart means open gap: {}", x[2]);
             }
             ContactState::Stick => {
@@ -1497,15 +1491,15 @@ mod tests {
             }
         }
         match &p.law.adhesion {
-            None => assert_eq!(s.r_adh, V3::zeros()),
+            None => assert_eq!(s.r_adh, Vec3::zeros()),
             Some(a) => {
                 let ut = Vec2::new(p.bond0.ut[0] + x[0], p.bond0.ut[1] + x[1]);
                 let beta = beta_update(p.bond0.beta, p.dt, a, x[2], ut);
                 assert!((beta - s.beta).abs() <= 1e-9, "β {beta} vs {}", s.beta);
                 let ra = adhesive_force(beta, a, x[2], ut, p.area);
-                let scale = Vec3::from(ra).norm() + p.area * a.peak_traction();
+                let scale = ra.norm() + p.area * a.peak_traction();
                 assert!(
-                    (Vec3::from(ra) - Vec3::from(s.r_adh)).norm() <= tol * scale,
+                    (ra - s.r_adh).norm() <= tol * scale,
                     "{ra:?} vs {:?}",
                     s.r_adh
                 );
@@ -1519,7 +1513,7 @@ mod tests {
     fn projection_cases_match_hand_values() {
         // Separating: μ‖r*_t‖ = 0.05 < 1 = −r*_n.
         let (r, c) = dry_projection(v3(0.1, 0.0, -1.0), 0.5);
-        assert_eq!((r, c), (V3::zeros(), ContactState::Apart));
+        assert_eq!((r, c), (Vec3::zeros(), ContactState::Apart));
         // Sticking: ‖r*_t‖ = 0.5 ≤ 1 = μ r*_n.
         let (r, c) = dry_projection(v3(0.3, 0.4, 2.0), 0.5);
         assert_eq!((r, c), (v3(0.3, 0.4, 2.0), ContactState::Stick));
@@ -1542,7 +1536,7 @@ mod tests {
         let (r, c) = dry_projection(v3(1.0, -2.0, 3.0), 0.0);
         assert_eq!((r, c), (v3(0.0, 0.0, 3.0), ContactState::Slide));
         let (r, c) = dry_projection(v3(1.0, -2.0, -3.0), 0.0);
-        assert_eq!((r, c), (V3::zeros(), ContactState::Apart));
+        assert_eq!((r, c), (Vec3::zeros(), ContactState::Apart));
         let (r, c) = dry_projection(v3(0.0, 0.0, 3.0), 0.0);
         assert_eq!((r, c), (v3(0.0, 0.0, 3.0), ContactState::Stick));
         // Negative μ is treated as 0.
@@ -1560,12 +1554,12 @@ mod tests {
         let st = rs[0].hypot(rs[1]);
         let t = [rs[0] / st, rs[1] / st];
         let k = (st - mu * rs[2]) / (1.0 + mu * mu);
-        let y = Vec3::from(rs) - Vec3::from(r);
+        let y = rs - r;
         assert_vec_close(y, v3(k * t[0], k * t[1], -k * mu), 1e-14);
-        let gen = [mu * t[0], mu * t[1], 1.0];
-        assert!(y.dot(&Vec3::from(gen)).abs() <= 1e-14 * Vec3::from(rs).norm());
+        let gen = v3(mu * t[0], mu * t[1], 1.0);
+        assert!(y.dot(&gen).abs() <= 1e-14 * rs.norm());
         let rn = r[2];
-        assert_vec_close(r, v3(rn * gen[0], rn * gen[1], rn * gen[2]), 1e-14);
+        assert_vec_close(r, rn * gen, 1e-14);
     }
 
     #[test]
@@ -1597,25 +1591,22 @@ mod tests {
             );
             let (r, c) = dry_projection(rs, mu);
             hits[c as usize] += 1;
-            let s = Vec3::from(rs).norm();
+            let s = rs.norm();
             let tol = 1e-12 * s;
             // In the cone.
             assert!(r[2] >= 0.0);
             assert!(r[0].hypot(r[1]) <= mu * r[2] + tol, "{rs:?} μ={mu}");
             // Idempotent.
             let (rr, cc) = dry_projection(r, mu);
-            assert!(
-                (Vec3::from(rr) - Vec3::from(r)).norm() <= tol,
-                "idempotence {rs:?} μ={mu}"
-            );
-            if Vec3::from(r).norm() > 0.0 {
+            assert!((rr - r).norm() <= tol, "idempotence {rs:?} μ={mu}");
+            if r.norm() > 0.0 {
                 assert_ne!(cc, ContactState::Apart);
             }
             // Moreau: y = r* − r lies in the polar cone {μ‖y_t‖ ≤ −y_n} and y ⊥ r.
-            let y = Vec3::from(rs) - Vec3::from(r);
+            let y = rs - r;
             assert!(mu * y[0].hypot(y[1]) + y[2] <= tol, "polar {rs:?} μ={mu}");
             assert!(
-                y.dot(&Vec3::from(r)).abs() <= 1e-12 * s * s,
+                y.dot(&r).abs() <= 1e-12 * s * s,
                 "orthogonality {rs:?} μ={mu}"
             );
             // Nearest point: no random point of the cone is closer.
@@ -1625,7 +1616,7 @@ mod tests {
                 let ang = rng.uniform(0.0, 2.0 * PI);
                 let kt = mu * kn * rng.uniform(0.0, 1.0);
                 let k = v3(kt * ang.cos(), kt * ang.sin(), kn);
-                assert!((Vec3::from(rs) - Vec3::from(k)).norm() >= d - tol);
+                assert!((rs - k).norm() >= d - tol);
             }
         }
         assert!(hits.iter().all(|&h| h > 1000), "all cases hit: {hits:?}");
@@ -1817,7 +1808,7 @@ mod tests {
         assert!(r[0] < 0.0);
         assert_eq!(
             adhesive_force(0.0, &p, 1e-5, Vec2::new(1e-5, 1e-5), 1e-6),
-            V3::zeros()
+            Vec3::zeros()
         );
     }
 
@@ -1887,7 +1878,7 @@ mod tests {
             let a = 1e-3 * k as f64 * xc;
             let mut p = problem(&law, w, v3(0.0, 0.0, a), bond);
             p.dt = 1.0;
-            let s = solve_point(&p, V3::zeros(), 1e-12, 50);
+            let s = solve_point(&p, Vec3::zeros(), 1e-12, 50);
             assert!(s.converged && s.iterations == 1, "step {k}: {s:?}");
             assert_eq!(s.state, ContactState::Apart);
             let x = s.x[2];
@@ -1927,7 +1918,7 @@ mod tests {
         // r̃(0) = (−0.04, 0, 0) N; pressing with 0.2 N gives μ r_n = 0.08 N.
         for (shear, state) in [(0.0, ContactState::Stick), (-5e-3, ContactState::Slide)] {
             let p = problem(&law, w, v3(shear, 0.0, -1e-2), bond);
-            let s = solve_point(&p, V3::zeros(), 1e-12, 50);
+            let s = solve_point(&p, Vec3::zeros(), 1e-12, 50);
             assert!(s.converged);
             assert_eq!(s.state, state, "shear {shear}");
             assert!(s.iterations <= 8, "{} iterations", s.iterations);
@@ -1940,10 +1931,10 @@ mod tests {
 
     #[test]
     fn default_rho_is_inverse_largest_eigenvalue() {
-        let w = m3([[2.0, 1.0, 0.0], [1.0, 2.0, 0.0], [0.0, 0.0, 1.0]]);
+        let w = mat3_from_rows([[2.0, 1.0, 0.0], [1.0, 2.0, 0.0], [0.0, 0.0, 1.0]]);
         assert!(rel(default_rho(w), 1.0 / 3.0) < 1e-14);
         assert!(rel(default_rho(diag(1e-6, 2e-6, 4e-6)), 2.5e5) < 1e-14);
-        assert_eq!(default_rho(M3::zeros()), 1.0);
+        assert_eq!(default_rho(Mat3::zeros()), 1.0);
         let mut rng = Rng(3);
         for _ in 0..1000 {
             let hi = 10f64.powf(rng.uniform(-6.9, -3.0));
@@ -1963,7 +1954,7 @@ mod tests {
     fn pressed_into_rigid_support() {
         let w = diag(1e-6, 1e-6, 2e-6);
         let p = problem(&DRY, w, v3(0.0, 0.0, -1e-4), BondState::default());
-        let s = solve_point(&p, V3::zeros(), 1e-12, 50);
+        let s = solve_point(&p, Vec3::zeros(), 1e-12, 50);
         assert!(s.converged);
         assert_eq!(s.state, ContactState::Stick);
         assert!(s.x[2].abs() <= 1e-12 * 1e-4, "x_n = {}", s.x[2]);
@@ -1976,7 +1967,7 @@ mod tests {
         let w = diag(1e-6, 1e-6, 2e-6);
         // Stick: the sticking force 10 N < μ r_n = 15 N.
         let p = problem(&DRY, w, v3(1e-5, 0.0, -1e-4), BondState::default());
-        let s = solve_point(&p, V3::zeros(), 1e-12, 50);
+        let s = solve_point(&p, Vec3::zeros(), 1e-12, 50);
         assert!(s.converged);
         assert_eq!(s.state, ContactState::Stick);
         assert!(s.x[0].hypot(s.x[1]) <= 1e-12 * 1e-4);
@@ -1984,7 +1975,7 @@ mod tests {
         check_solution(&p, &s, 1e-10);
         // Slide: the sticking force would be 50 N > 15 N.
         let p = problem(&DRY, w, v3(3e-5, 4e-5, -1e-4), BondState::default());
-        let s = solve_point(&p, V3::zeros(), 1e-12, 50);
+        let s = solve_point(&p, Vec3::zeros(), 1e-12, 50);
         assert!(s.converged);
         assert_eq!(s.state, ContactState::Slide);
         assert_vec_close(s.r(), v3(-9.0, -12.0, 50.0), 1e-10);
@@ -1997,7 +1988,7 @@ mod tests {
             anisotropy: None,
         };
         let p = problem(&law, w, v3(3e-5, 4e-5, -1e-4), BondState::default());
-        let s = solve_point(&p, V3::zeros(), 1e-12, 50);
+        let s = solve_point(&p, Vec3::zeros(), 1e-12, 50);
         assert!(s.converged);
         assert_vec_close(s.r(), v3(0.0, 0.0, 50.0), 1e-12);
         assert_vec_close(s.x, v3(3e-5, 4e-5, 0.0), 1e-10);
@@ -2010,7 +2001,7 @@ mod tests {
         let s = solve_point(&p, v3(5.0, 0.0, 30.0), 1e-12, 50);
         assert!(s.converged);
         assert_eq!(s.state, ContactState::Apart);
-        assert_eq!(s.r(), V3::zeros());
+        assert_eq!(s.r(), Vec3::zeros());
         assert_eq!(s.x, p.x_free);
         assert!(s.iterations <= 2);
     }
@@ -2031,7 +2022,7 @@ mod tests {
         for wnn in [1e-4, 5e-2] {
             let w = diag(1e-4, 1e-4, wnn);
             let p = problem(&law, w, v3(0.0, 0.0, 1e-5), bond);
-            let s = solve_point(&p, V3::zeros(), 1e-12, 50);
+            let s = solve_point(&p, Vec3::zeros(), 1e-12, 50);
             assert!(s.converged, "W_nn = {wnn}");
             let k = 2e9 * 1e-6;
             let xn = 1e-5 / (1.0 + k * wnn);
@@ -2059,7 +2050,7 @@ mod tests {
             damage: 0.0,
         };
         let p = problem(&law, w, v3(2e-3, 0.0, -1e-3), bond);
-        let s = solve_point(&p, V3::zeros(), 1e-12, 100);
+        let s = solve_point(&p, Vec3::zeros(), 1e-12, 100);
         assert!(s.converged);
         assert!(s.beta > 0.0);
         assert_eq!(s.ut, Vec2::new(1e-6 + s.x[0], s.x[1]));
@@ -2072,11 +2063,11 @@ mod tests {
         };
         let mut p = problem(&law, w, v3(0.0, 0.0, 3e-2), bond);
         p.dt = 1.0;
-        let s = solve_point(&p, V3::zeros(), 1e-12, 100);
+        let s = solve_point(&p, Vec3::zeros(), 1e-12, 100);
         assert!(s.converged);
         assert_eq!(s.beta, 0.0);
         assert_eq!(s.ut, Vec2::zeros());
-        assert_eq!(s.r(), V3::zeros());
+        assert_eq!(s.r(), Vec3::zeros());
     }
 
     /// A set of point problems over stiffness ratios, loadings and bond states.
@@ -2142,7 +2133,7 @@ mod tests {
         let mut stats = [(0usize, 0usize, 0usize); 5];
         let mut states = [0usize; 3];
         sweep_cases(&mut rng, 1500, |p, label| {
-            let s = solve_point(p, V3::zeros(), 1e-10, 50);
+            let s = solve_point(p, Vec3::zeros(), 1e-10, 50);
             assert!(s.converged, "{label}: {s:?} {p:?}");
             check_solution(p, &s, 1e-8);
             let k = label_ratio_index(label);
@@ -2198,21 +2189,18 @@ mod tests {
             let p = problem(&law, w, x_free, BondState::default());
             let fp = solve_point_impl(
                 &p,
-                V3::zeros(),
+                Vec3::zeros(),
                 1e-10,
                 5000,
                 Method::Bipotential { newton: false },
             );
             assert!(fp.converged, "case {i}");
             worst = worst.max(fp.iterations);
-            let nw = solve_point(&p, V3::zeros(), 1e-10, 50);
+            let nw = solve_point(&p, Vec3::zeros(), 1e-10, 50);
             assert!(nw.converged);
             assert_eq!(fp.state, nw.state, "case {i}");
-            let scale = Vec3::from(fp.r()).norm() + p.rho * Vec3::from(x_free).norm();
-            assert!(
-                (Vec3::from(fp.r()) - Vec3::from(nw.r())).norm() <= 1e-8 * scale,
-                "case {i}"
-            );
+            let scale = fp.r().norm() + p.rho * x_free.norm();
+            assert!((fp.r() - nw.r()).norm() <= 1e-8 * scale, "case {i}");
         }
         // Condition number 10: the fixed point needs ~κ·ln(1/tol) iterations.
         assert!(worst <= 400, "worst {worst}");
@@ -2223,7 +2211,7 @@ mod tests {
         // W = εI + (1 − ε) v vᵀ, v = (1, 1, 1)/√3: λ_max = 1 but W_ii ≈ 1/3, so ρ = 1/max W_ii ≈ 3
         // exceeds 2/λ_max and the sticking iteration r ← r − ρ W r − ρ x_free diverges.
         let eps = 0.05;
-        let w = M3::from_fn(|i, j| (1.0 - eps) / 3.0 + if i == j { eps } else { 0.0 });
+        let w = Mat3::from_fn(|i, j| (1.0 - eps) / 3.0 + if i == j { eps } else { 0.0 });
         let law = InterfaceLaw {
             mu: 1.0,
             adhesion: None,
@@ -2232,7 +2220,7 @@ mod tests {
         let mut p = problem(&law, w, v3(0.0, 0.0, -1.0), BondState::default());
         let ok = solve_point_impl(
             &p,
-            V3::zeros(),
+            Vec3::zeros(),
             1e-10,
             5000,
             Method::Bipotential { newton: false },
@@ -2242,18 +2230,16 @@ mod tests {
         p.rho = 1.0 / w[(0, 0)];
         let bad = solve_point_impl(
             &p,
-            V3::zeros(),
+            Vec3::zeros(),
             1e-10,
             5000,
             Method::Bipotential { newton: false },
         );
         assert!(!bad.converged);
         // The default solver does not depend on ρ for its answer.
-        let s = solve_point(&p, V3::zeros(), 1e-10, 50);
+        let s = solve_point(&p, Vec3::zeros(), 1e-10, 50);
         assert!(s.converged);
-        assert!(
-            (Vec3::from(s.r()) - Vec3::from(ok.r())).norm() <= 1e-8 * Vec3::from(ok.r()).norm()
-        );
+        assert!((s.r() - ok.r()).norm() <= 1e-8 * ok.r().norm());
     }
 
     #[test]
@@ -2276,7 +2262,7 @@ mod tests {
             ut: Vec2::zeros(),
             damage: 0.0,
         };
-        let mut r = V3::zeros();
+        let mut r = Vec3::zeros();
         let mut snap_off = None;
         let mut snap_back = None;
         let mut prev_xn = 0.0;
@@ -2332,9 +2318,9 @@ mod tests {
             ut: Vec2::new(1e-5, 0.0),
             damage: 0.0,
         };
-        let cases: [(M3, V3, f64, f64); 6] = [
-            (M3::zeros(), v3(0.0, 0.0, -1e-4), 1e-6, 1e-4),
-            (M3::zeros(), v3(1e-5, 0.0, 1e-5), 1e-6, 1e-4),
+        let cases: [(Mat3, Vec3, f64, f64); 6] = [
+            (Mat3::zeros(), v3(0.0, 0.0, -1e-4), 1e-6, 1e-4),
+            (Mat3::zeros(), v3(1e-5, 0.0, 1e-5), 1e-6, 1e-4),
             (diag(1e-4, 1e-4, 1e-4), v3(1e-5, 0.0, 1e-5), 0.0, 1e-4),
             (diag(1e-4, 1e-4, 1e-4), v3(1e-5, 0.0, 1e-5), 1e-6, 0.0),
             (
@@ -2357,11 +2343,11 @@ mod tests {
             };
             let s = solve_point(&p, v3(1.0, 2.0, 3.0), 1e-10, 30);
             assert!(s.iterations <= 30);
-            let _ = solve_point(&p, V3::repeat(f64::NAN), 1e-10, 0);
+            let _ = solve_point(&p, Vec3::repeat(f64::NAN), 1e-10, 0);
         }
         // W = 0 with an open gap and no adhesion: r = 0 at once.
         let p = PointProblem {
-            w_aa: M3::zeros(),
+            w_aa: Mat3::zeros(),
             x_free: v3(0.0, 0.0, 1e-3),
             law: &DRY,
             bond0: BondState::default(),
@@ -2369,8 +2355,8 @@ mod tests {
             area: 1e-6,
             rho: 1.0,
         };
-        let s = solve_point(&p, V3::zeros(), 1e-10, 10);
-        assert!(s.converged && s.r() == V3::zeros());
+        let s = solve_point(&p, Vec3::zeros(), 1e-10, 10);
+        assert!(s.converged && s.r() == Vec3::zeros());
     }
 
     /// Without fatigue, D counts w per unit of β lost and nothing for β gained.

@@ -18,16 +18,13 @@
 //! max(‖q‖, ‖r‖, ‖x‖) (q = x at r = 0, the free relative displacement), the normalisation of
 //! Siconos 4.4's `fc3d_compute_error`, and returns the raw norm when all three vanish.
 
-use super::law::{bipotential_trial, dry_projection};
-use crate::Vec3;
+use super::law::{natural_map_defect, InterfaceLaw};
 
 /// Natural-map defect F = r − P_K(r − ρ(x + μ‖x_t‖n)) at one point, components (t1, t2, n),
 /// for the force `r` [N], local relative displacement `x` [m], friction coefficient `mu` and
 /// ρ [N/m].
 pub fn natural_map_point(r: [f64; 3], x: [f64; 3], mu: f64, rho: f64) -> [f64; 3] {
-    let (r, x) = (Vec3::from(r), Vec3::from(x));
-    let (p, _) = dry_projection(bipotential_trial(r, x, mu, rho), mu);
-    (r - p).into()
+    natural_map_defect(&InterfaceLaw::coulomb(mu), rho, r.into(), x.into()).into()
 }
 
 /// ‖F‖ over all points with ρ = 1 (unnormalised; see the module documentation):

@@ -323,49 +323,26 @@ mod tests {
     fn a_fixed_point_satisfies_the_coulomb_law_in_every_case() {
         let law = dry(0.5);
         let rho = 1e3;
+        let at = |lambda: Vec3, x: Vec3| {
+            augmented_point(&law, BondState::default(), 1e-3, 1.0, rho, lambda, x)
+        };
         // Apart: positive gap, zero multiplier.
-        let ev = augmented_point(
-            &law,
-            BondState::default(),
-            1e-3,
-            1.0,
-            rho,
-            Vec3::zeros(),
-            Vec3::new(1e-3, 0.0, 2e-3),
-        );
+        let ev = at(Vec3::zeros(), Vec3::new(1e-3, 0.0, 2e-3));
         assert_eq!(ev.solution.state, ContactState::Apart);
         assert_eq!(ev.defect, Vec3::zeros());
         // Stick: closed, no slip, force inside the cone.
-        let lam = Vec3::new(0.1, -0.2, 1.0);
-        let ev = augmented_point(
-            &law,
-            BondState::default(),
-            1e-3,
-            1.0,
-            rho,
-            lam,
-            Vec3::zeros(),
-        );
+        let ev = at(Vec3::new(0.1, -0.2, 1.0), Vec3::zeros());
         assert_eq!(ev.solution.state, ContactState::Stick);
         assert_eq!(ev.defect, Vec3::zeros());
         assert_eq!(ev.stiffness[(0, 0)], rho);
         // Slide: on the cone, opposing the slip, with x_n = 0.
         let lam = Vec3::new(-0.3, -0.4, 1.0); // |r_t| = 0.5 = μ r_n
-        let slip = Vec3::new(3e-4, 4e-4, 0.0);
-        let ev = augmented_point(&law, BondState::default(), 1e-3, 1.0, rho, lam, slip);
+        let ev = at(lam, Vec3::new(3e-4, 4e-4, 0.0));
         assert_eq!(ev.solution.state, ContactState::Slide);
         let d = ev.defect.iter().map(|v| v.abs()).fold(0.0, f64::max);
         assert!(d < 1e-12, "defect {d}");
         // The wrong direction of slip is not a fixed point.
-        let ev = augmented_point(
-            &law,
-            BondState::default(),
-            1e-3,
-            1.0,
-            rho,
-            lam,
-            Vec3::new(-3e-4, -4e-4, 0.0),
-        );
+        let ev = at(lam, Vec3::new(-3e-4, -4e-4, 0.0));
         assert!(ev.defect.iter().any(|v| v.abs() > 1e-3));
     }
 

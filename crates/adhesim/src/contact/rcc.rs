@@ -148,12 +148,10 @@ impl Interface for InterfaceLaw {
 
     fn point_history(&self, node: &NodeHistory, frame: &[[f64; 3]; 3]) -> BondState {
         let h = RccHistory::decode(node);
+        let ut = Vec3::from(h.ut);
         BondState {
             beta: h.beta,
-            ut: Vec2::new(
-                Vec3::from(h.ut).dot(&Vec3::from(frame[0])),
-                Vec3::from(h.ut).dot(&Vec3::from(frame[1])),
-            ),
+            ut: Vec2::new(ut.dot(&Vec3::from(frame[0])), ut.dot(&Vec3::from(frame[1]))),
             damage: h.damage,
         }
     }

@@ -38,7 +38,7 @@ use faer::{Conj, MatMut, Par, Spec};
 use super::law::{
     bipotential_trial, dry_projection, modified_displacement_jacobian, projection_jacobian,
 };
-use super::natural_map::{natural_map_residual, relative_error};
+use super::natural_map::{natural_map_point, natural_map_residual, relative_error};
 use super::reduced::{gauss_seidel_sweep, point_rhos, BlockSparseDelassus, ReducedSolution};
 
 type M3 = [[f64; 3]; 3];
@@ -82,10 +82,8 @@ fn natural_map_rho(
     w.apply(r, q, x);
     let mut theta = 0.0;
     for p in 0..r.len() {
-        let trial = bipotential_trial(r[p].into(), x[p].into(), mu[p], rho[p]);
-        let (proj, _) = dry_projection(trial, mu[p]);
+        f[p] = natural_map_point(r[p], x[p], mu[p], rho[p]);
         for a in 0..3 {
-            f[p][a] = r[p][a] - proj[a];
             theta += 0.5 * f[p][a] * f[p][a];
         }
     }

@@ -21,7 +21,7 @@ use crate::contact::newton::add_contact_tangent;
 use crate::contact::newton::RHO_FACTOR;
 use crate::linalg::{gmres_with_remainder, KrylovLimits};
 use crate::system::SystemMatrix;
-use crate::{mat3_from_rows, rows_of, Mat3};
+use crate::{rows_of, Mat3};
 use std::time::Instant;
 
 /// ρ_α of the natural map the Newton iterations work on, as a multiple of the stiffness K̄
@@ -335,7 +335,8 @@ impl MixedDirection for CondensedDirection<'_> {
         momentum: f64,
     ) -> Result<Option<Direction>, String> {
         let m = lin.len();
-        let (mut s, mut g, mut positive) = (
+        let (mut s, mut g, mut positive, mut rest) = (
+            Vec::with_capacity(m),
             Vec::with_capacity(m),
             Vec::with_capacity(m),
             Vec::with_capacity(m),
@@ -352,6 +353,8 @@ impl MixedDirection for CondensedDirection<'_> {
             };
             let p = positive_symmetric_part(&(inv_plain * l.b_plain));
             positive.push(rows_of(&p));
+            // The part of S the preconditioner leaves out.
+            rest.push(sa - p);
             g.push(inv * nalgebra::Vector3::from(l.phi));
             s.push(sa);
         }
@@ -371,16 +374,10 @@ impl MixedDirection for CondensedDirection<'_> {
         for (h, ga) in self.h.iter().zip(&g) {
             add_ht_terms(h, (-ga).into(), &mut rhs);
         }
-        // The part of S the preconditioner leaves out.
-        let rest: Vec<Mat3> = s
-            .iter()
-            .zip(&positive)
-            .map(|(sa, p)| sa - mat3_from_rows(*p))
-            .collect();
         let h = self.h;
         let (pattern, values, factor) = self.system.operator_and_factor();
         // Only the points whose S the preconditioner leaves part of.
-        let rest: Vec<(&Vec<(usize, [f64; 3])>, Mat3)> = h
+        let rest: Vec<_> = h
             .iter()
             .zip(rest)
             .filter(|(_, ra)| ra.iter().any(|&e| e != 0.0))
