@@ -2,8 +2,8 @@
 //! exit codes (0 success, 1 the run stopped early, 2 invalid input or unwritable output,
 //! 130 interrupted by Ctrl-C or SIGTERM with a checkpoint to resume from).
 
-use adhesim::run::{Outcome, Progress};
 use adhesim::time::StepReport;
+use adhesim_io::run::{Outcome, Progress};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -283,7 +283,7 @@ fn main() -> ExitCode {
             };
             sweep(&scenario, request)
         }
-        Command::Plot { dir } => match adhesim::run::draw_figures(&dir) {
+        Command::Plot { dir } => match adhesim_io::run::draw_figures(&dir) {
             Ok(files) => {
                 for f in files {
                     println!("{}", f.display());
@@ -304,16 +304,16 @@ fn fail_input(msg: impl std::fmt::Display) -> ExitCode {
 fn load_options(
     variant: Option<String>,
     overrides: &[String],
-) -> Result<adhesim::scenario::LoadOptions, String> {
+) -> Result<adhesim_io::scenario::LoadOptions, String> {
     let overrides = overrides
         .iter()
-        .map(|o| adhesim::scenario::Override::parse(o).map_err(|e| format!("--set: {e}")))
+        .map(|o| adhesim_io::scenario::Override::parse(o).map_err(|e| format!("--set: {e}")))
         .collect::<Result<Vec<_>, _>>()?;
-    Ok(adhesim::scenario::LoadOptions { variant, overrides })
+    Ok(adhesim_io::scenario::LoadOptions { variant, overrides })
 }
 
-fn check(path: &Path, opts: &adhesim::scenario::LoadOptions) -> ExitCode {
-    let scenario = match adhesim::scenario::load_with(path, opts) {
+fn check(path: &Path, opts: &adhesim_io::scenario::LoadOptions) -> ExitCode {
+    let scenario = match adhesim_io::scenario::load_with(path, opts) {
         Ok(p) => p,
         Err(e) => return fail_input(e),
     };
@@ -343,14 +343,14 @@ fn check(path: &Path, opts: &adhesim::scenario::LoadOptions) -> ExitCode {
 
 fn run(
     path: &Path,
-    opts: &adhesim::scenario::LoadOptions,
+    opts: &adhesim_io::scenario::LoadOptions,
     out: Option<PathBuf>,
     checkpoint_every: usize,
     resume: Option<PathBuf>,
     overwrite: bool,
     quiet: bool,
 ) -> ExitCode {
-    let scenario = match adhesim::scenario::load_with(path, opts) {
+    let scenario = match adhesim_io::scenario::load_with(path, opts) {
         Ok(p) => p,
         Err(e) => return fail_input(e),
     };
@@ -361,7 +361,7 @@ fn run(
         };
         PathBuf::from("out").join(name)
     });
-    let control = adhesim::run::RunControl {
+    let control = adhesim_io::run::RunControl {
         checkpoint_every,
         resume: resume.is_some(),
         stop: Some(stop_on_signals()),
@@ -369,7 +369,7 @@ fn run(
         refuse_existing_run: !overwrite,
     };
     let mut progress: Box<dyn Progress> = if quiet {
-        Box::new(adhesim::run::Silent)
+        Box::new(adhesim_io::run::Silent)
     } else if std::io::stderr().is_terminal() {
         Box::new(Bar::new())
     } else {
@@ -387,7 +387,7 @@ fn run(
         }
     }
     let summary =
-        match adhesim::run::run_with(scenario, Some(path), &out, progress.as_mut(), &control) {
+        match adhesim_io::run::run_with(scenario, Some(path), &out, progress.as_mut(), &control) {
             Ok(s) => s,
             Err(e) => return fail_input(format!("{}: {e}", path.display())),
         };
@@ -545,8 +545,8 @@ struct SweepLines {
     start: Instant,
 }
 
-impl adhesim::sweep::SweepProgress for SweepLines {
-    fn started(&self, case: &adhesim::sweep::Case, total: usize) {
+impl adhesim_io::sweep::SweepProgress for SweepLines {
+    fn started(&self, case: &adhesim_io::sweep::Case, total: usize) {
         if !self.quiet {
             eprintln!(
                 "[{:>6.1} s] case {}/{total} started: {}",
@@ -558,9 +558,9 @@ impl adhesim::sweep::SweepProgress for SweepLines {
     }
     fn finished(
         &self,
-        case: &adhesim::sweep::Case,
+        case: &adhesim_io::sweep::Case,
         total: usize,
-        result: &Result<adhesim::run::RunSummary, String>,
+        result: &Result<adhesim_io::run::RunSummary, String>,
     ) {
         let what = match result {
             Ok(s) => match &s.outcome {
@@ -607,13 +607,13 @@ fn sweep(path: &Path, r: SweepRequest) -> ExitCode {
     let axes = match r
         .axes
         .iter()
-        .map(|a| adhesim::sweep::Axis::parse(a))
+        .map(|a| adhesim_io::sweep::Axis::parse(a))
         .collect::<Result<Vec<_>, _>>()
     {
         Ok(a) => a,
         Err(e) => return fail_input(format!("--set: {e}")),
     };
-    let plan = match adhesim::sweep::SweepPlan::new(path, r.variant.clone(), &r.fixed, &axes) {
+    let plan = match adhesim_io::sweep::SweepPlan::new(path, r.variant.clone(), &r.fixed, &axes) {
         Ok(p) => p,
         Err(e) => return fail_input(format!("{}: {e}", path.display())),
     };
@@ -622,7 +622,7 @@ fn sweep(path: &Path, r: SweepRequest) -> ExitCode {
         Ok(o) => o,
         Err(e) => return fail_input(e.replace("--set", "--fix")),
     };
-    let scenario = match adhesim::scenario::load_with(path, &base) {
+    let scenario = match adhesim_io::scenario::load_with(path, &base) {
         Ok(p) => p,
         Err(e) => return fail_input(e),
     };
@@ -644,7 +644,7 @@ fn sweep(path: &Path, r: SweepRequest) -> ExitCode {
         .map(|n| n.get())
         .unwrap_or(1);
     let jobs = r.jobs.unwrap_or(cores).max(1);
-    let options = adhesim::sweep::SweepOptions {
+    let options = adhesim_io::sweep::SweepOptions {
         jobs,
         threads_per_case: (cores / jobs).max(1),
         checkpoint_every: r.checkpoint_every,
@@ -665,7 +665,7 @@ fn sweep(path: &Path, r: SweepRequest) -> ExitCode {
         quiet: r.quiet,
         start: Instant::now(),
     };
-    let summary = match adhesim::sweep::run_sweep(&plan, &options, &out, &progress) {
+    let summary = match adhesim_io::sweep::run_sweep(&plan, &options, &out, &progress) {
         Ok(s) => s,
         Err(e) => return fail_input(format!("{}: {e}", path.display())),
     };
@@ -706,7 +706,7 @@ fn sweep(path: &Path, r: SweepRequest) -> ExitCode {
 /// `adhesim sweep … --slurm`: validates every case, writes the plan and the job-array
 /// script, and submits it with --submit.
 fn slurm_sweep(
-    plan: &adhesim::sweep::SweepPlan,
+    plan: &adhesim_io::sweep::SweepPlan,
     out: &Path,
     checkpoint_every: usize,
     resume: bool,
@@ -717,14 +717,14 @@ fn slurm_sweep(
     if let Err(e) = plan.load_cases() {
         return fail_input(format!("{file}: {e}"));
     }
-    if let Err(e) = adhesim::sweep::check_folder(plan, out, resume, overwrite) {
+    if let Err(e) = adhesim_io::sweep::check_folder(plan, out, resume, overwrite) {
         return fail_input(e);
     }
     let (dir, exe) = match (std::path::absolute(out), std::env::current_exe()) {
         (Ok(d), Ok(e)) => (d, e),
         (Err(e), _) | (_, Err(e)) => return fail_input(format!("{}: {e}", out.display())),
     };
-    let options = adhesim::slurm::SlurmOptions {
+    let options = adhesim_io::slurm::SlurmOptions {
         partition: args.partition,
         time: args.time,
         mem: args.mem,
@@ -736,14 +736,14 @@ fn slurm_sweep(
     if let Err(e) = plan.write(&dir) {
         return fail_input(e);
     }
-    let script = match adhesim::slurm::write_script(plan, &dir, &exe, &options) {
+    let script = match adhesim_io::slurm::write_script(plan, &dir, &exe, &options) {
         Ok(s) => s,
         Err(e) => return fail_input(e),
     };
     eprintln!(
         "{} cases: plan {}, job-array script {}",
         plan.cases.len(),
-        dir.join(adhesim::sweep::PLAN_FILE).display(),
+        dir.join(adhesim_io::sweep::PLAN_FILE).display(),
         script.display()
     );
     if !args.submit {
@@ -759,7 +759,7 @@ fn slurm_sweep(
 
 /// `adhesim sweep submit DIR`: submits the given cases, or every unfinished one.
 fn submit(dir: &Path, cases: &[usize]) -> ExitCode {
-    let plan = match adhesim::sweep::SweepPlan::read(dir) {
+    let plan = match adhesim_io::sweep::SweepPlan::read(dir) {
         Ok(p) => p,
         Err(e) => return fail_input(e),
     };
@@ -767,7 +767,7 @@ fn submit(dir: &Path, cases: &[usize]) -> ExitCode {
         plan.cases
             .iter()
             .filter(|c| {
-                !matches!(adhesim::sweep::read_run(&dir.join(&c.dir)),
+                !matches!(adhesim_io::sweep::read_run(&dir.join(&c.dir)),
                     Some(s) if s.outcome == Outcome::Finished)
             })
             .map(|c| c.number)
@@ -789,11 +789,11 @@ fn submit(dir: &Path, cases: &[usize]) -> ExitCode {
         );
         return ExitCode::SUCCESS;
     }
-    match adhesim::slurm::submit(dir, &numbers) {
+    match adhesim_io::slurm::submit(dir, &numbers) {
         Ok(id) => {
             eprintln!(
                 "submitted job {id}: cases {} (logs in {})",
-                adhesim::slurm::array_spec(&numbers),
+                adhesim_io::slurm::array_spec(&numbers),
                 dir.join("slurm").display()
             );
             println!("{id}");
@@ -805,7 +805,7 @@ fn submit(dir: &Path, cases: &[usize]) -> ExitCode {
 
 /// `adhesim sweep collect DIR`.
 fn collect(dir: &Path, quiet: bool) -> ExitCode {
-    let collected = match adhesim::sweep::collect(dir) {
+    let collected = match adhesim_io::sweep::collect(dir) {
         Ok(c) => c,
         Err(e) => return fail_input(e),
     };
@@ -820,7 +820,7 @@ fn collect(dir: &Path, quiet: bool) -> ExitCode {
                     "interrupted at t = {:.4e} s (resubmit to resume it)",
                     s.t_reached
                 )),
-                Outcome::Running if adhesim::outdir::is_locked(&case_dir) => {
+                Outcome::Running if adhesim_io::outdir::is_locked(&case_dir) => {
                     Some(format!("running, at t = {:.4e} s", s.t_reached))
                 }
                 Outcome::Running => Some(format!(

@@ -3,7 +3,7 @@
 //! uninterrupted run.
 #![cfg(unix)]
 
-use adhesim::output::csv::read_history;
+use adhesim_io::output::csv::read_history;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::OnceLock;

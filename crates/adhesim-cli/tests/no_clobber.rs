@@ -4,7 +4,7 @@
 //! finished run is refused without --resume or --overwrite and left byte for byte as it was.
 #![cfg(unix)]
 
-use adhesim::output::csv::read_history;
+use adhesim_io::output::csv::read_history;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 

@@ -7,9 +7,9 @@
 //! copy per value. Every scenario error is raised as `ScenarioError` with the message that
 //! `adhesim check` prints.
 
-use adhesim::run::{Progress, RunControl};
-use adhesim::scenario::{LoadOptions, Override};
 use adhesim::time::StepReport;
+use adhesim_io::run::{Progress, RunControl};
+use adhesim_io::scenario::{LoadOptions, Override};
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;
 use pyo3::prelude::*;
@@ -55,9 +55,9 @@ fn load(
     path: &Path,
     variant: Option<String>,
     overrides: &[String],
-) -> PyResult<adhesim::scenario::Scenario> {
+) -> PyResult<adhesim_io::scenario::Scenario> {
     let options = load_options(variant, overrides)?;
-    let scenario = adhesim::scenario::parse_with(text, path, &options)
+    let scenario = adhesim_io::scenario::parse_with(text, path, &options)
         .map_err(|e| ScenarioError::new_err(e.to_string()))?;
     if let Err(err) = adhesim::time::check_elements(&scenario.problem) {
         return Err(ScenarioError::new_err(format!("{}: {err}", path.display())));
@@ -111,7 +111,7 @@ fn check(
         "cells": problem.bodies.iter().map(|b| b.mesh.num_cells()).sum::<usize>(),
         "t_end": problem.time.t_end,
         "dt": problem.time.dt,
-        "fingerprint": format!("{:016x}", adhesim::checkpoint::fingerprint(problem, &scenario.output)),
+        "fingerprint": format!("{:016x}", adhesim_io::checkpoint::fingerprint(problem, &scenario.output)),
         "warnings": warnings,
     });
     Ok(info.to_string())
@@ -236,7 +236,7 @@ fn run<'py>(
     let scenario_file = from_file.then_some(path.as_path());
     let summary = py
         .allow_threads(|| {
-            adhesim::run::run_with(scenario, scenario_file, &out_dir, &mut progress, &control)
+            adhesim_io::run::run_with(scenario, scenario_file, &out_dir, &mut progress, &control)
         })
         .map_err(|e| RunError::new_err(format!("{}: {e}", path.display())))?;
     if let Some(e) = progress.error {
@@ -253,7 +253,7 @@ fn read_history<'py>(
     py: Python<'py>,
     path: PathBuf,
 ) -> PyResult<(Vec<String>, usize, Bound<'py, PyBytes>)> {
-    let (names, rows) = adhesim::output::csv::read_history(&path)
+    let (names, rows) = adhesim_io::output::csv::read_history(&path)
         .map_err(|e| pyo3::exceptions::PyOSError::new_err(e.to_string()))?;
     let mut bytes = Vec::with_capacity(rows.len() * names.len() * 8);
     for row in &rows {
@@ -283,7 +283,7 @@ fn sweep(
     resume: bool,
     overwrite: bool,
 ) -> PyResult<String> {
-    use adhesim::sweep::{Axis, SweepError, SweepOptions, SweepPlan};
+    use adhesim_io::sweep::{Axis, SweepError, SweepOptions, SweepPlan};
     let axes = axes
         .iter()
         .map(|a| Axis::parse(a))
@@ -307,7 +307,7 @@ fn sweep(
     // free for other threads meanwhile.
     let summary = py
         .allow_threads(|| {
-            adhesim::sweep::run_sweep(&plan, &options, &out_dir, &adhesim::sweep::QuietSweep)
+            adhesim_io::sweep::run_sweep(&plan, &options, &out_dir, &adhesim_io::sweep::QuietSweep)
         })
         .map_err(|e| match e {
             SweepError::Scenario { .. } | SweepError::Axes(_) => {

@@ -596,7 +596,7 @@ fn run_child(cfg: &Config, kind: Kind, n: usize) -> Outcome {
 /// Runs the timed steps of one size, then the analysis of W.
 fn run_size(cfg: &Config, n: usize) -> SizeResult {
     let text = scenario(cfg, n);
-    let problem = adhesim::scenario::parse(&text, Path::new("bench_contact.toml"))
+    let problem = adhesim_io::scenario::parse(&text, Path::new("bench_contact.toml"))
         .unwrap_or_else(|e| fail(&format!("scenario: {e}")))
         .problem;
     let problem = Arc::new(problem);
@@ -813,7 +813,7 @@ fn subset_delassus(
 /// contact nodes with a dense W of the full size.
 fn probe_size(cfg: &Config, n: usize) -> ProbeResult {
     let text = scenario(cfg, n);
-    let problem = adhesim::scenario::parse(&text, Path::new("bench_contact.toml"))
+    let problem = adhesim_io::scenario::parse(&text, Path::new("bench_contact.toml"))
         .unwrap_or_else(|e| fail(&format!("scenario: {e}")))
         .problem;
     let problem = Arc::new(problem);

@@ -6,8 +6,8 @@
 //! [N]. The closed form of the fatigue law, A √(C_n w/(1 + (k−1) w/D_f)) with the scenario's
 //! values, is drawn beside them. Prints a table.
 
-use adhesim::output::csv::read_history;
-use adhesim::output::plot::{draw_line_plot, LinePlot, Series};
+use adhesim_io::output::csv::read_history;
+use adhesim_io::output::plot::{draw_line_plot, LinePlot, Series};
 use std::path::Path;
 
 fn main() {

@@ -6,8 +6,8 @@
 //! (the flat's motion, 0.25 mm over 1 s), the force 4 × `flat.fy` (four quarters) [N].
 //! Prints the table of force over Hertz at each step.
 
-use adhesim::output::csv::read_history;
-use adhesim::output::plot::{draw_line_plot, LinePlot, Series};
+use adhesim_io::output::csv::read_history;
+use adhesim_io::output::plot::{draw_line_plot, LinePlot, Series};
 use std::path::Path;
 
 /// Sphere radius [m], indentation at t = 1 s [m], shear and bulk moduli [Pa] of the scenario.

@@ -8,8 +8,8 @@
 //! (μ₁ = 0.6 along x, μ₂ = 0.2 along z) and the isotropic answer (along the drag), and prints
 //! a table with |F_t|/N.
 
-use adhesim::output::csv::read_history;
-use adhesim::output::plot::{draw_line_plot, LinePlot, Series};
+use adhesim_io::output::csv::read_history;
+use adhesim_io::output::plot::{draw_line_plot, LinePlot, Series};
 use std::path::Path;
 
 fn main() {

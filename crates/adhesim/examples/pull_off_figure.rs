@@ -5,8 +5,8 @@
 //! largest tensile force of the `flat` contact pair on the cap, −min(flat.fy) [N]. Prints a
 //! table and draws the figure (x: log₁₀ of the speed).
 
-use adhesim::output::csv::read_history;
-use adhesim::output::plot::{draw_line_plot, LinePlot, Series};
+use adhesim_io::output::csv::read_history;
+use adhesim_io::output::plot::{draw_line_plot, LinePlot, Series};
 use std::path::Path;
 
 fn main() {

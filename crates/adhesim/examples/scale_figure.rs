@@ -5,7 +5,7 @@
 //! data file of `bench/scale/run.sh`. Each point is the median CPU time (user + system) of
 //! the runs of one program, solver and size; contact nodes are (n + 1)². Prints a table.
 
-use adhesim::output::plot::{draw_line_plot, LinePlot, Series};
+use adhesim_io::output::plot::{draw_line_plot, LinePlot, Series};
 use std::collections::BTreeMap;
 use std::path::Path;
 

@@ -1,15 +1,15 @@
 //! adhesim: finite-element dynamics of soft bodies in frictional contact with recoverable
 //! adhesion (Raous-Cangémi-Cocou interface, bi-potential contact solver, NSCD θ-method).
 //!
-//! Data flows one way: a scenario file is parsed and validated into a [`problem::Problem`], a
-//! [`time::Stepper`] advances it step by step, and [`output::Observer`]s record what was
-//! computed. Physics never formats output and output never does physics.
+//! Data flows one way: a [`problem::Problem`] (read from a scenario file by the `adhesim-io`
+//! crate, or built in code) is advanced step by step by a [`time::Stepper`], whose committed
+//! states the `adhesim-io` crate's observers record. This crate is the physics (meshes,
+//! elements, materials, contact, time stepping): it parses no scenario and writes no output.
 //!
 //! Units are SI throughout (m, kg, s, N, Pa).
 
 pub mod anp;
 pub mod assembly;
-pub mod checkpoint;
 pub mod contact;
 pub mod diagnosis;
 pub mod element;
@@ -18,15 +18,9 @@ pub mod gravity;
 pub mod linalg;
 pub mod material;
 pub mod mesh;
-pub mod outdir;
-pub mod output;
 pub mod prescribed;
 pub mod problem;
-pub mod run;
-pub mod scenario;
-pub mod slurm;
 pub mod sparse_lu;
-pub mod sweep;
 pub mod system;
 pub mod time;
 pub mod warnings;

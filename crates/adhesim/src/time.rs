@@ -17,7 +17,7 @@ mod newton_coupling;
 mod newton_loop;
 
 pub use attempt::PhaseTimes;
-pub use constraints::Constraints;
+pub use constraints::{thickness_ties, Constraints};
 
 use crate::assembly::{BadElement, Discretisation};
 use crate::contact::detect::{align_frames, detect, ContactPoint};

@@ -248,14 +248,14 @@ density = 1000.0
         )
     };
     let path = std::path::Path::new("anp.toml");
-    let ok = adhesim::scenario::parse(
+    let ok = adhesim_io::scenario::parse(
         &text(r#"{ model = "mooney-rivlin", c10 = 0.3e6, c01 = 0.1e6, kappa = 1e9 }"#),
         path,
     )
     .expect("a valid scenario")
     .problem;
     assert_eq!(ok.bodies[0].element, ANP);
-    let err = adhesim::scenario::parse(&text(r#"{ model = "blatz-ko", g = 1e6 }"#), path)
+    let err = adhesim_io::scenario::parse(&text(r#"{ model = "blatz-ko", g = 1e6 }"#), path)
         .expect_err("Blatz-Ko has no volumetric split")
         .to_string();
     assert!(

@@ -100,7 +100,7 @@ detection_distance = 1e-3
         dt_min = dt / 64.0,
         v = -V0
     );
-    let problem = adhesim::scenario::parse(&text, Path::new("bar_impact.toml"))
+    let problem = adhesim_io::scenario::parse(&text, Path::new("bar_impact.toml"))
         .expect("valid scenario")
         .problem;
     let clock = Instant::now();

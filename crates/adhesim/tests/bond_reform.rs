@@ -36,7 +36,7 @@ detection_distance = 5e-4
 
 #[test]
 fn bond_breaks_and_reforms_with_the_same_pull_off_force() {
-    let problem = adhesim::scenario::parse(SCENARIO, Path::new("bond_reform.toml"))
+    let problem = adhesim_io::scenario::parse(SCENARIO, Path::new("bond_reform.toml"))
         .unwrap()
         .problem;
     let centre = problem.contacts[0]

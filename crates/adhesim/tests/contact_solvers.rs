@@ -6,8 +6,8 @@
 
 use adhesim::contact::RccHistory;
 use adhesim::problem::Problem;
-use adhesim::scenario::{load_with, LoadOptions, Override};
 use adhesim::time::{NodeContact, Stepper};
+use adhesim_io::scenario::{load_with, LoadOptions, Override};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -271,7 +271,7 @@ detection_distance = 1e-3
 "#;
     use adhesim::problem::ContactSolver;
     for solver in [ContactSolver::Newton, ContactSolver::Semismooth] {
-        let mut problem = adhesim::scenario::parse(text, Path::new("drag.toml"))
+        let mut problem = adhesim_io::scenario::parse(text, Path::new("drag.toml"))
             .unwrap()
             .problem;
         problem.time.contact_solver = solver;

@@ -28,7 +28,7 @@ friction = {mu}
 detection_distance = 1e-3
 "#
     );
-    let problem = adhesim::scenario::parse(&text, Path::new("coulomb.toml"))
+    let problem = adhesim_io::scenario::parse(&text, Path::new("coulomb.toml"))
         .expect("valid scenario")
         .problem;
     let nodes = (0..problem.bodies[0].mesh.num_nodes()).collect();

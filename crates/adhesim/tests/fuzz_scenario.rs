@@ -7,7 +7,7 @@
 //!
 //! `ADHESIM_FUZZ_CASES` sets the number of cases (default 20000).
 
-use adhesim::scenario::{parse, parse_with, LoadOptions};
+use adhesim_io::scenario::{parse, parse_with, LoadOptions};
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};

@@ -6,7 +6,7 @@
 use adhesim::element::{hex8_geometry, tet4_geometry};
 use adhesim::mesh::gmsh::{self, GmshBody, Location};
 use adhesim::mesh::{quality, Mesh};
-use adhesim::run::{run, Outcome, Silent};
+use adhesim_io::run::{run, Outcome, Silent};
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -143,7 +143,7 @@ fn shipped_mesh_counts_sets_and_volumes() {
 #[test]
 fn shipped_scenario_loads_and_presses_the_layer() {
     let path = root().join("scenarios/gmsh/hemisphere_on_layer.toml");
-    let problem = adhesim::scenario::load(&path).unwrap().problem;
+    let problem = adhesim_io::scenario::load(&path).unwrap().problem;
     assert_eq!(problem.bodies.len(), 2);
     // Scaled from millimetres: the hemisphere's flat top is at y = 10.1 mm.
     let top = problem.bodies[0]
@@ -158,11 +158,11 @@ fn shipped_scenario_loads_and_presses_the_layer() {
         .unwrap()
         .replace("t_end = 2.0", "t_end = 1.0")
         .replace("dt = 0.1", "dt = 0.25");
-    let problem = adhesim::scenario::parse(&text, &path).unwrap();
+    let problem = adhesim_io::scenario::parse(&text, &path).unwrap();
     let out = std::env::temp_dir().join("adhesim-test-gmsh-hemisphere");
     let summary = run(problem, Some(&path), &out, &mut Silent).unwrap();
     assert_eq!(summary.outcome, Outcome::Finished);
-    let (cols, rows) = adhesim::output::csv::read_history(out.join("history.csv")).unwrap();
+    let (cols, rows) = adhesim_io::output::csv::read_history(out.join("history.csv")).unwrap();
     let col = |name: &str| cols.iter().position(|c| c == name).unwrap();
     let last = rows.last().unwrap();
     // 1 mm into the layer. Hertz gives F = 4/3 E* √R d^(3/2) = 1.9 N on the layer taken as
@@ -177,7 +177,7 @@ fn shipped_scenario_loads_and_presses_the_layer() {
 
 fn scenario_error(text: &str, dir: &Path) -> String {
     let path = dir.join("s.toml");
-    adhesim::scenario::parse(text, &path)
+    adhesim_io::scenario::parse(text, &path)
         .unwrap_err()
         .to_string()
 }
@@ -218,7 +218,7 @@ fn scenario_errors_name_the_key_and_the_file() {
     assert!(e.contains("`body[0].mesh.scale`"), "{e}");
     let e = scenario_error(&with(r#", generator = "block""#), &dir);
     assert!(e.contains("not both"), "{e}");
-    adhesim::scenario::parse(&with(""), &dir.join("s.toml"))
+    adhesim_io::scenario::parse(&with(""), &dir.join("s.toml"))
         .unwrap()
         .problem;
 

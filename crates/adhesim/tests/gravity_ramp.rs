@@ -4,8 +4,8 @@
 //! the small-deflection closed form: tip deflection δ = w L⁴/(8 E I) (Euler-Bernoulli) plus
 //! w L²/(2 κ G A) (shear, Timoshenko), w = ρ g A the weight per length.
 
-use adhesim::run::{run, Outcome, Silent};
 use adhesim::time::Stepper;
+use adhesim_io::run::{run, Outcome, Silent};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -46,7 +46,7 @@ fix = ["x", "y", "z"]
 
 /// Mean vertical displacement of the free end face [m].
 fn tip_deflection(nx: usize, ny: usize) -> f64 {
-    let problem = adhesim::scenario::parse(&cantilever(nx, ny), Path::new("sag.toml"))
+    let problem = adhesim_io::scenario::parse(&cantilever(nx, ny), Path::new("sag.toml"))
         .expect("valid")
         .problem;
     let right = problem.bodies[0].mesh.node_sets["right"].clone();
@@ -130,27 +130,27 @@ figures = false
 }
 
 fn run_text(text: &str, tag: &str) -> Outcome {
-    let problem = adhesim::scenario::parse(text, Path::new("soft-sag.toml")).unwrap();
+    let problem = adhesim_io::scenario::parse(text, Path::new("soft-sag.toml")).unwrap();
     run_problem(problem, tag)
 }
 
-fn run_problem(problem: adhesim::scenario::Scenario, tag: &str) -> Outcome {
+fn run_problem(problem: adhesim_io::scenario::Scenario, tag: &str) -> Outcome {
     let out = std::env::temp_dir().join(format!("adhesim-test-gravity-{tag}"));
     let _ = std::fs::remove_dir_all(&out);
     run(problem, None, &out, &mut Silent).unwrap().outcome
 }
 
 /// scenarios/cantilever-sag.toml, with `overrides` (`KEY=VALUE`).
-fn shipped_sag(overrides: &[&str]) -> adhesim::scenario::Scenario {
+fn shipped_sag(overrides: &[&str]) -> adhesim_io::scenario::Scenario {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/cantilever-sag.toml");
-    let options = adhesim::scenario::LoadOptions {
+    let options = adhesim_io::scenario::LoadOptions {
         variant: None,
         overrides: overrides
             .iter()
-            .map(|o| adhesim::scenario::Override::parse(o).unwrap())
+            .map(|o| adhesim_io::scenario::Override::parse(o).unwrap())
             .collect(),
     };
-    adhesim::scenario::load_with(&path, &options).unwrap()
+    adhesim_io::scenario::load_with(&path, &options).unwrap()
 }
 
 #[test]
@@ -206,7 +206,7 @@ fn a_body_held_by_nothing_is_named() {
 #[test]
 fn gravity_errors_name_the_key() {
     let err = |g: &str| {
-        adhesim::scenario::parse(&soft_sag(g, true), Path::new("soft-sag.toml"))
+        adhesim_io::scenario::parse(&soft_sag(g, true), Path::new("soft-sag.toml"))
             .unwrap_err()
             .to_string()
     };

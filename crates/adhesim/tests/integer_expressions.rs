@@ -30,7 +30,7 @@ fix = ["x", "y", "z"]
 #[test]
 fn integer_keys_take_expressions() {
     let text = scenario(r#"["= nx", 2, "= nx / 2"]"#);
-    let p = adhesim::scenario::parse(&text, Path::new("ints.toml"))
+    let p = adhesim_io::scenario::parse(&text, Path::new("ints.toml"))
         .unwrap()
         .problem;
     let mesh = &p.bodies[0].mesh;
@@ -43,7 +43,7 @@ fn integer_keys_take_expressions() {
 #[test]
 fn a_fractional_value_for_an_integer_key_names_the_key() {
     let text = scenario(r#"["= nx / 3", 2, 2]"#);
-    let err = adhesim::scenario::parse(&text, Path::new("ints.toml"))
+    let err = adhesim_io::scenario::parse(&text, Path::new("ints.toml"))
         .unwrap_err()
         .to_string();
     assert!(err.contains("divisions"), "{err}");

@@ -28,7 +28,7 @@ fn run(fatigue: bool) -> Vec<(f64, f64, f64)> {
         assert!(text.contains(key));
         text = text.replace(key, "");
     }
-    let problem = adhesim::scenario::parse(&text, &path)
+    let problem = adhesim_io::scenario::parse(&text, &path)
         .unwrap_or_else(|e| panic!("{e}"))
         .problem;
     let centre = problem.contacts[0]

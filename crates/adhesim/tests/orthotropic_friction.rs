@@ -27,7 +27,7 @@ fn drag(angle_deg: f64, edit: impl Fn(String) -> String) -> (f64, f64, f64, bool
         .join("../../scenarios/interface/orthotropic-drag.toml");
     let text = std::fs::read_to_string(&path).unwrap();
     let text = edit(text.replace("drag_angle = 45.0", &format!("drag_angle = {angle_deg:?}")));
-    let problem = adhesim::scenario::parse(&text, &path)
+    let problem = adhesim_io::scenario::parse(&text, &path)
         .unwrap_or_else(|e| panic!("{e}"))
         .problem;
     let mut s = Stepper::new(Arc::new(problem)).unwrap();

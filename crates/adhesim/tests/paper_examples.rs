@@ -2,8 +2,8 @@
 //! shipped scenarios in `scenarios/paper/`. Each check compares runs of the same scenario
 //! that differ in one parameter, as the paper's studies do.
 
-use adhesim::run::{run, Outcome, Silent};
-use adhesim::scenario::{load_with, LoadOptions, Override};
+use adhesim_io::run::{run, Outcome, Silent};
+use adhesim_io::scenario::{load_with, LoadOptions, Override};
 use std::path::{Path, PathBuf};
 
 fn scenario(name: &str) -> PathBuf {
@@ -65,7 +65,7 @@ fn run_coarse(file: &str, tag: &str, overrides: &[&str]) -> History {
     let out = std::env::temp_dir().join(format!("adhesim-test-paper-{tag}"));
     let summary = run(problem, Some(&path), &out, &mut Silent).unwrap();
     assert_eq!(summary.outcome, Outcome::Finished, "{file} {overrides:?}");
-    let (cols, rows) = adhesim::output::csv::read_history(out.join("history.csv")).unwrap();
+    let (cols, rows) = adhesim_io::output::csv::read_history(out.join("history.csv")).unwrap();
     History { cols, rows }
 }
 

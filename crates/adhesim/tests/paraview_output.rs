@@ -7,8 +7,8 @@
 //! Needs python3 with `vtk` and `meshio` (`.ci/run` installs them). Without them the test
 //! says so and passes, unless the environment variable `CI` is set, where it fails.
 
-use adhesim::output::csv::read_history;
-use adhesim::run::{run_with, Outcome, RunControl, Silent};
+use adhesim_io::output::csv::read_history;
+use adhesim_io::run::{run_with, Outcome, RunControl, Silent};
 use serde_json::Value;
 use std::collections::BTreeSet;
 use std::path::Path;
@@ -111,7 +111,7 @@ fn vtk_and_meshio_read_every_data_set_of_every_frame() {
     }
     let dir = std::env::temp_dir().join("adhesim-test-paraview-output");
     let _ = std::fs::remove_dir_all(&dir);
-    let problem = adhesim::scenario::parse(SCENARIO, Path::new("frames.toml")).unwrap();
+    let problem = adhesim_io::scenario::parse(SCENARIO, Path::new("frames.toml")).unwrap();
     let summary = run_with(problem, None, &dir, &mut Silent, &RunControl::default()).unwrap();
     assert_eq!(summary.outcome, Outcome::Finished);
     assert_eq!(summary.frames, 5);

@@ -9,10 +9,10 @@
 //!    balances the moment Σ r × f of the contact forces on the bottom face, both taken about
 //!    the top face's centroid and summed independently here from the stepper's state.
 
-use adhesim::output::csv::read_history;
-use adhesim::run::{run_with, Outcome, RunControl, Silent};
-use adhesim::scenario::{load_with, LoadOptions};
 use adhesim::time::Stepper;
+use adhesim_io::output::csv::read_history;
+use adhesim_io::run::{run_with, Outcome, RunControl, Silent};
+use adhesim_io::scenario::{load_with, LoadOptions};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -82,7 +82,7 @@ figures = false
 fn compressed_stack_reaction_matches_contact_force_and_closed_form() {
     let dir = std::env::temp_dir().join("adhesim-test-reactions-stack");
     let _ = std::fs::remove_dir_all(&dir);
-    let problem = adhesim::scenario::parse(&block_scenario(), Path::new("stack.toml")).unwrap();
+    let problem = adhesim_io::scenario::parse(&block_scenario(), Path::new("stack.toml")).unwrap();
     let s = run_with(problem, None, &dir, &mut Silent, &RunControl::default()).unwrap();
     assert_eq!(s.outcome, Outcome::Finished);
     let (columns, rows) = read_history(dir.join("history.csv")).unwrap();
@@ -197,9 +197,9 @@ fn twist_reaction_moment_balances_the_contact_moment() {
     // Pair totals: on the plane y = 0 the tangential resultant is the x, z part of the
     // resultant contact force, and tiny next to the sum of the nodal tangential force norms
     // (the nodal forces turn round the centre and cancel).
-    let totals = adhesim::output::pair_totals(&s.contact[0]);
+    let totals = adhesim_io::output::pair_totals(&s.contact[0]);
     let get = |name: &str| {
-        let i = adhesim::output::PAIR_TOTAL_FIELDS
+        let i = adhesim_io::output::PAIR_TOTAL_FIELDS
             .iter()
             .position(|f| *f == name);
         totals[i.unwrap()]
@@ -244,7 +244,7 @@ fn boundary_names_are_unique() {
         "[[boundary]]\nname = \"base\"\nbody = \"lower\"\nset = \"left\"",
         1,
     );
-    let err = adhesim::scenario::parse(&two_named, Path::new("stack.toml"))
+    let err = adhesim_io::scenario::parse(&two_named, Path::new("stack.toml"))
         .unwrap_err()
         .to_string();
     assert!(
@@ -252,7 +252,7 @@ fn boundary_names_are_unique() {
         "{err}"
     );
     let same_set = block_scenario().replacen("set = \"back\"", "set = \"left\"", 1);
-    let p = adhesim::scenario::parse(&same_set, Path::new("stack.toml")).unwrap();
+    let p = adhesim_io::scenario::parse(&same_set, Path::new("stack.toml")).unwrap();
     let names = &p.output.boundary_names;
     assert!(names.contains(&"lower.left".to_string()), "{names:?}");
     assert!(names.contains(&"lower.left.3".to_string()), "{names:?}");

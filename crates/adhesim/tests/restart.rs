@@ -2,11 +2,11 @@
 //! the outputs of an uninterrupted run bit for bit (history rows, frames, the final β), the
 //! wall-clock timing columns of history.csv excepted.
 
-use adhesim::checkpoint::{Checkpoint, CheckpointError};
 use adhesim::contact::RccHistory;
-use adhesim::output::csv::read_history;
-use adhesim::run::{run_with, Outcome, RunControl, RunError, Silent};
-use adhesim::scenario::Scenario;
+use adhesim_io::checkpoint::{Checkpoint, CheckpointError};
+use adhesim_io::output::csv::read_history;
+use adhesim_io::run::{run_with, Outcome, RunControl, RunError, Silent};
+use adhesim_io::scenario::Scenario;
 use std::path::{Path, PathBuf};
 
 /// The shipped indentation scenario, coarsened and cut to its loading phase (1 s, 50 steps):
@@ -18,7 +18,7 @@ fn problem(w: f64) -> Scenario {
         .replace("t_end = 4.0", "t_end = 1.0")
         .replace("divisions = [60, 6, 1]", "divisions = [30, 3, 1]")
         .replace("w = 20.0", &format!("w = {w:?}"));
-    adhesim::scenario::parse(&text, &path).unwrap()
+    adhesim_io::scenario::parse(&text, &path).unwrap()
 }
 
 fn fresh_dir(tag: &str) -> PathBuf {
@@ -27,7 +27,7 @@ fn fresh_dir(tag: &str) -> PathBuf {
     dir
 }
 
-fn go(dir: &Path, control: RunControl) -> Result<adhesim::run::RunSummary, RunError> {
+fn go(dir: &Path, control: RunControl) -> Result<adhesim_io::run::RunSummary, RunError> {
     run_with(problem(20.0), None, dir, &mut Silent, &control)
 }
 

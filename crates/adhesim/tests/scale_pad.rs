@@ -17,8 +17,8 @@
 //! well below the 3.6 % by which friction raises the force, so the test fails if friction
 //! is lost or misapplied.
 
-use adhesim::run::{run, Outcome, Silent};
-use adhesim::scenario::{load_with, LoadOptions, Override};
+use adhesim_io::run::{run, Outcome, Silent};
+use adhesim_io::scenario::{load_with, LoadOptions, Override};
 use std::path::{Path, PathBuf};
 
 fn scenario() -> PathBuf {
@@ -35,7 +35,7 @@ fn normal_force(sets: &[&str], tag: &str) -> Vec<(f64, f64)> {
     let out = std::env::temp_dir().join(format!("adhesim-test-scale-pad-{tag}"));
     let summary = run(problem, Some(&scenario()), &out, &mut Silent).unwrap();
     assert_eq!(summary.outcome, Outcome::Finished);
-    let (cols, rows) = adhesim::output::csv::read_history(out.join("history.csv")).unwrap();
+    let (cols, rows) = adhesim_io::output::csv::read_history(out.join("history.csv")).unwrap();
     let col = |name: &str| cols.iter().position(|c| c == name).unwrap();
     let (t, fy) = (col("t"), col("ground.fy"));
     rows.iter().map(|r| (r[t], r[fy])).collect()

@@ -1,7 +1,7 @@
 //! Every shipped scenario runs (on a coarse setting where it is long) and gives the answer
 //! it is there to show.
 
-use adhesim::run::{run, Outcome, Silent};
+use adhesim_io::run::{run, Outcome, Silent};
 use std::path::{Path, PathBuf};
 
 fn scenario(name: &str) -> PathBuf {
@@ -11,7 +11,7 @@ fn scenario(name: &str) -> PathBuf {
 }
 
 fn column(dir: &Path, name: &str) -> Vec<f64> {
-    let (cols, rows) = adhesim::output::csv::read_history(dir.join("history.csv")).unwrap();
+    let (cols, rows) = adhesim_io::output::csv::read_history(dir.join("history.csv")).unwrap();
     let i = cols
         .iter()
         .position(|c| c == name)
@@ -22,7 +22,7 @@ fn column(dir: &Path, name: &str) -> Vec<f64> {
 #[test]
 fn cantilever_runs_and_balances_its_energy() {
     let path = scenario("cantilever.toml");
-    let problem = adhesim::scenario::load(&path).unwrap();
+    let problem = adhesim_io::scenario::load(&path).unwrap();
     let out = std::env::temp_dir().join("adhesim-test-cantilever");
     let summary = run(problem, Some(&path), &out, &mut Silent).unwrap();
     assert_eq!(summary.outcome, Outcome::Finished);
@@ -50,7 +50,7 @@ fn indentation_bonds_and_debonds_from_the_rim_inwards() {
     let text = std::fs::read_to_string(&path)
         .unwrap()
         .replace("dt = 0.02", "dt = 0.05");
-    let problem = adhesim::scenario::parse(&text, &path).unwrap();
+    let problem = adhesim_io::scenario::parse(&text, &path).unwrap();
     let out = std::env::temp_dir().join("adhesim-test-indentation");
     let summary = run(problem, Some(&path), &out, &mut Silent).unwrap();
     assert_eq!(summary.outcome, Outcome::Finished);
@@ -98,7 +98,7 @@ fn tet_hemisphere_follows_hertz() {
     let text = std::fs::read_to_string(&path)
         .unwrap()
         .replace("t_end = 1.0", "t_end = 0.2");
-    let problem = adhesim::scenario::parse(&text, &path).unwrap();
+    let problem = adhesim_io::scenario::parse(&text, &path).unwrap();
     let out = std::env::temp_dir().join("adhesim-test-tet-hemisphere");
     let summary = run(problem, Some(&path), &out, &mut Silent).unwrap();
     assert_eq!(summary.outcome, Outcome::Finished);

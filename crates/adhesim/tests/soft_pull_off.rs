@@ -6,8 +6,8 @@
 //! after the hold (4 τ) it equals the force of the same run with the long-term elastic
 //! material μ∞ = μ₀ (1 − g), within the few % of relaxation left and of nonlinearity.
 
-use adhesim::run::{run, Outcome, Silent};
-use adhesim::scenario::{load_with, LoadOptions, Override};
+use adhesim_io::run::{run, Outcome, Silent};
+use adhesim_io::scenario::{load_with, LoadOptions, Override};
 use std::path::Path;
 
 /// Runs the coarse variant with `overrides`; returns (t, flat.fy, flat.bonded) per step.
@@ -25,7 +25,7 @@ fn run_case(tag: &str, overrides: &[&str]) -> Vec<(f64, f64, f64)> {
     let out = std::env::temp_dir().join(format!("adhesim-test-pull-off-{tag}"));
     let summary = run(problem, Some(&path), &out, &mut Silent).unwrap();
     assert_eq!(summary.outcome, Outcome::Finished, "{overrides:?}");
-    let (cols, rows) = adhesim::output::csv::read_history(out.join("history.csv")).unwrap();
+    let (cols, rows) = adhesim_io::output::csv::read_history(out.join("history.csv")).unwrap();
     let col = |name: &str| cols.iter().position(|c| c == name).unwrap();
     let (t, fy, b) = (col("t"), col("flat.fy"), col("flat.bonded"));
     rows.iter().map(|r| (r[t], r[fy], r[b])).collect()

@@ -4,8 +4,8 @@
 //! slave node, edges and corners included, while the nodal forces are not uniform: an edge
 //! node carries half the force of an interior node, a corner node a quarter.
 
-use adhesim::output::csv::read_history;
-use adhesim::run::{run_with, Outcome, RunControl, Silent};
+use adhesim_io::output::csv::read_history;
+use adhesim_io::run::{run_with, Outcome, RunControl, Silent};
 use std::path::Path;
 
 const E: f64 = 2e6;
@@ -62,7 +62,7 @@ figures = false
 fn uniformly_pressed_pad_shows_uniform_pressure() {
     let dir = std::env::temp_dir().join("adhesim-test-tractions-pad");
     let _ = std::fs::remove_dir_all(&dir);
-    let problem = adhesim::scenario::parse(&scenario(), Path::new("pad.toml")).unwrap();
+    let problem = adhesim_io::scenario::parse(&scenario(), Path::new("pad.toml")).unwrap();
     let s = run_with(problem, None, &dir, &mut Silent, &RunControl::default()).unwrap();
     assert_eq!(s.outcome, Outcome::Finished);
     let (columns, rows) = read_history(dir.join("maps/ground_t1.csv")).unwrap_or_else(|e| {

@@ -43,7 +43,7 @@ detection_distance = 1e-3
 
 #[test]
 fn pressed_blocks_balance_forces_and_share_a_symmetric_pressure() {
-    let problem = adhesim::scenario::parse(SCENARIO, Path::new("two_blocks.toml"))
+    let problem = adhesim_io::scenario::parse(SCENARIO, Path::new("two_blocks.toml"))
         .unwrap()
         .problem;
     let lower = &problem.bodies[0].mesh;

@@ -17,7 +17,7 @@ use crate::output::maps::MapObserver;
 use crate::output::plot::PlotError;
 use crate::output::{FrameWriter, HistoryObserver, Observer, StepView};
 use crate::scenario::Scenario;
-use crate::time::{SetupError, StepReport, Stepper};
+use adhesim::time::{SetupError, StepReport, Stepper};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -345,7 +345,7 @@ pub fn run_with(
                     }
                 }
                 Err(e) => {
-                    let message = crate::diagnosis::describe_step_failure(&problem, &e);
+                    let message = adhesim::diagnosis::describe_step_failure(&problem, &e);
                     progress.message(&message);
                     summary.outcome = Outcome::Failed(message);
                     return Ok(());

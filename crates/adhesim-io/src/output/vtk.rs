@@ -47,9 +47,9 @@ pub enum CellKind {
     Tri3,
     /// Single point (`VTK_VERTEX`, 1).
     Vertex,
-    /// A volume element type of the element-type table ([`crate::element::ELEMENT_TYPES`]:
+    /// A volume element type of the element-type table ([`adhesim::element::ELEMENT_TYPES`]:
     /// hex8 is `VTK_HEXAHEDRON`, 12, tet4 `VTK_TETRA`, 10), with its VTK type and node count.
-    Element(&'static crate::element::ElementType),
+    Element(&'static adhesim::element::ElementType),
 }
 
 impl CellKind {
@@ -668,7 +668,7 @@ fn push_time(out: &mut String, t: f64) {
 mod tests {
     use super::super::atomic::test_support::TestDir;
     use super::*;
-    use crate::element::{HEX8, TET4};
+    use adhesim::element::{HEX8, TET4};
     use base64::Engine as _;
 
     /// A parsed XML element (test-only, strict subset of XML: no comments, CDATA or DTD).

@@ -5,15 +5,15 @@
 //! then checks values (positive moduli, time step, existing node sets, ...) and names the key
 //! that is wrong and what would be valid. The format is documented in `docs/scenario.md`.
 
-use crate::contact::detect::{thickness_twins, tributary_areas};
-use crate::contact::law::{Interface, Orthotropy, DEFAULT_BETA_EPS};
-use crate::contact::{ContactPair, InterfaceLaw, Master, RccParams, RigidMotion, RigidShape};
-use crate::material::{self, Hyperelastic};
-use crate::mesh::generate::{self, FlatSide};
-use crate::mesh::{gmsh, quality};
-use crate::mesh::{Face, Mesh};
 use crate::output::settings::{MapRequest, OutputSettings, Track};
-use crate::problem::{
+use adhesim::contact::detect::{thickness_twins, tributary_areas};
+use adhesim::contact::law::{Interface, Orthotropy, DEFAULT_BETA_EPS};
+use adhesim::contact::{ContactPair, InterfaceLaw, Master, RccParams, RigidMotion, RigidShape};
+use adhesim::material::{self, Hyperelastic};
+use adhesim::mesh::generate::{self, FlatSide};
+use adhesim::mesh::{gmsh, quality};
+use adhesim::mesh::{Face, Mesh};
+use adhesim::problem::{
     Body, ContactSolver, Dirichlet, NodalLoad, Problem, Rotation, Table, TimeSettings,
 };
 use serde::Deserialize;
@@ -504,22 +504,22 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Scenario, ScenarioError> {
         let material = build_material(&b.material, &format!("{key}.material"), ctx)?;
         let density = ctx.positive(&format!("{key}.density"), b.density)?;
         let element = match b.element.as_deref() {
-            None | Some("standard") => crate::fbar::Formulation::Standard,
+            None | Some("standard") => adhesim::fbar::Formulation::Standard,
             Some("fbar") => {
                 if material.small_strain() {
                     return Err(ctx.err(format!(
                         "`{key}.element` = \"fbar\" needs a finite-strain material; \"linear-elastic\" uses linear kinematics"
                     )));
                 }
-                crate::fbar::Formulation::FBar
+                adhesim::fbar::Formulation::FBar
             }
             Some("anp") => {
-                if !crate::anp::has_volumetric_split(&*material) {
+                if !adhesim::anp::has_volumetric_split(&*material) {
                     return Err(ctx.err(format!(
                         "`{key}.element` = \"anp\" needs a material with a bulk modulus split off: \"uncoupled-neo-hookean\", \"mooney-rivlin\" or \"ogden\" (optionally viscoelastic)"
                     )));
                 }
-                crate::fbar::Formulation::AveragedNodalPressure
+                adhesim::fbar::Formulation::AveragedNodalPressure
             }
             Some(other) => {
                 return Err(ctx.err(format!(
@@ -743,12 +743,12 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Scenario, ScenarioError> {
         });
     }
     let gravity = match &raw.gravity {
-        None => crate::gravity::Gravity::default(),
+        None => adhesim::gravity::Gravity::default(),
         Some(FileGravity::Constant(g)) => {
-            crate::gravity::Gravity::constant(ctx.finite3("gravity", *g)?)
+            adhesim::gravity::Gravity::constant(ctx.finite3("gravity", *g)?)
         }
         Some(FileGravity::Tables(c)) => {
-            let mut g = crate::gravity::Gravity::default();
+            let mut g = adhesim::gravity::Gravity::default();
             for (k, (cname, t)) in [("x", &c.x), ("y", &c.y), ("z", &c.z)]
                 .into_iter()
                 .enumerate()

@@ -19,7 +19,7 @@ pub struct OutputSettings {
     pub figures: bool,
     /// Maps of contact fields over a pair's slave surface at given times.
     pub maps: Vec<MapRequest>,
-    /// Name under which the reaction of each entry of [`crate::problem::Problem::dirichlet`] is written to
+    /// Name under which the reaction of each entry of [`adhesim::problem::Problem::dirichlet`] is written to
     /// the history (same order); an empty name, or an entry beyond the list, is not written.
     pub boundary_names: Vec<String>,
     /// Nodes whose fields are written to the history at every step.

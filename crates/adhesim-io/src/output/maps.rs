@@ -11,9 +11,9 @@
 use super::csv::read_history;
 use super::plot::{draw_scalar_map_with, ColorMap, PlotError, ScalarMap, ScalarValues};
 use super::{contact_node_fields, contact_node_values, Observer, StepView, CONTACT_NODE_FIELDS};
-use crate::contact::history::{self, FieldKind, HistoryField};
-use crate::contact::Interface;
 use crate::output::settings::MapRequest;
+use adhesim::contact::history::{self, FieldKind, HistoryField};
+use adhesim::contact::Interface;
 use std::collections::BTreeMap;
 use std::io;
 use std::path::{Path, PathBuf};

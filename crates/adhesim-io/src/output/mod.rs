@@ -9,12 +9,12 @@ pub mod plot;
 pub mod settings;
 pub mod vtk;
 
-use crate::assembly::Discretisation;
-use crate::contact::history::{FieldKind, HistoryField, Slot};
-use crate::contact::{Interface, Master, RigidShape};
-use crate::element::von_mises;
-use crate::problem::{Dirichlet, Problem};
-use crate::time::{NodeContact, State, StepReport};
+use adhesim::assembly::Discretisation;
+use adhesim::contact::history::{FieldKind, HistoryField, Slot};
+use adhesim::contact::{Interface, Master, RigidShape};
+use adhesim::element::von_mises;
+use adhesim::problem::{Dirichlet, Problem};
+use adhesim::time::{NodeContact, State, StepReport};
 use settings::OutputSettings;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -33,7 +33,7 @@ pub struct StepView<'a> {
     /// Committed contact state per pair and slave node.
     pub contact: &'a [Vec<NodeContact>],
     /// Nodal reaction forces of the step [N], 3 per node, zero on free degrees of freedom
-    /// (see [`crate::time::Stepper::reactions`]).
+    /// (see [`adhesim::time::Stepper::reactions`]).
     pub reactions: &'a [f64],
 }
 
@@ -147,7 +147,7 @@ fn frame_file_index(rest: &str) -> Option<usize> {
 struct BodyFrame {
     points: Vec<[f64; 3]>,
     /// The body's cell blocks: element type and connectivity.
-    blocks: Vec<crate::mesh::CellBlock>,
+    blocks: Vec<adhesim::mesh::CellBlock>,
     u: Vec<[f64; 3]>,
     v: Vec<[f64; 3]>,
     cauchy: Vec<[f64; 9]>,
@@ -186,7 +186,7 @@ fn body_frames(view: &StepView) -> Vec<BodyFrame> {
             node_id: (0..nn).map(|i| id_i32(off + i)).collect(),
             body_id: vec![id_i32(bi); body.mesh.num_cells()],
         };
-        let mut push = |s: crate::Mat3, j: f64| {
+        let mut push = |s: adhesim::Mat3, j: f64| {
             f.cauchy.push(std::array::from_fn(|k| s[(k / 3, k % 3)]));
             f.mises.push(von_mises(&s));
             f.jac.push(j);
@@ -338,7 +338,7 @@ struct ContactFrame {
 
 fn contact_frame(
     index: usize,
-    pair: &crate::contact::ContactPair,
+    pair: &adhesim::contact::ContactPair,
     nodes: &[NodeContact],
     view: &StepView,
 ) -> ContactFrame {
@@ -881,7 +881,7 @@ impl Observer for HistoryObserver {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::LawHistory;
+    use adhesim::contact::LawHistory;
 
     #[test]
     fn frame_files_are_recognised_by_their_number() {
@@ -932,7 +932,7 @@ mod tests {
             r_dry: [3.0, 0.0, 2.0],
             force: [0.0, 2.0, 3.0],
             tangent_axes: axes,
-            history: crate::contact::RccHistory {
+            history: adhesim::contact::RccHistory {
                 beta: 0.5,
                 ..Default::default()
             }
@@ -962,7 +962,7 @@ mod tests {
     /// them: β first, D last.
     #[test]
     fn rcc_contact_node_fields_keep_their_order() {
-        use crate::contact::{InterfaceLaw, RccHistory};
+        use adhesim::contact::{InterfaceLaw, RccHistory};
         let fields = InterfaceLaw::coulomb(0.3).history_fields();
         assert_eq!(
             contact_node_fields(fields),

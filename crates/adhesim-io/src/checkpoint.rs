@@ -13,11 +13,11 @@
 //! and last an FNV-1a 64 checksum of everything before it. The file is replaced atomically
 //! (see [`crate::output::atomic`]), so there is always one complete checkpoint: the last.
 
-use crate::contact::history::MAX_HISTORY_VALUES;
 use crate::output::settings::OutputSettings;
 use crate::output::FrameProgress;
-use crate::problem::Problem;
-use crate::time::{CachedDelassus, DelassusCache, NodeContact, Snapshot};
+use adhesim::contact::history::MAX_HISTORY_VALUES;
+use adhesim::problem::Problem;
+use adhesim::time::{CachedDelassus, DelassusCache, NodeContact, Snapshot};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -331,7 +331,7 @@ impl Checkpoint {
 
 /// The contact nodes of a pair in format 4: per node β, u_t (3), then the
 /// [`NodeContact::to_values`], then D, then the state code. β, u_t and D are the first five
-/// values of the RCC law's history ([`crate::contact::RccHistory`]), in its order.
+/// values of the RCC law's history ([`adhesim::contact::RccHistory`]), in its order.
 fn rcc_only_nodes(c: &mut impl Codec, nodes: &mut Vec<NodeContact>) -> Result<(), String> {
     c.count(nodes, 8 * (NodeContact::VALUES + 5) + 4)?;
     for node in nodes.iter_mut() {
@@ -488,12 +488,12 @@ impl Codec for Dec<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::LawHistory;
     use crate::output::vtk::PvdEntry;
+    use adhesim::contact::LawHistory;
 
     fn sample() -> Checkpoint {
         let c = NodeContact {
-            history: crate::contact::RccHistory {
+            history: adhesim::contact::RccHistory {
                 beta: 0.25,
                 ut: [1e-9, -2e-9, 0.0],
                 damage: 0.125,
@@ -527,7 +527,7 @@ mod tests {
                 delassus: Some(CachedDelassus {
                     key: vec![7, u64::MAX],
                     frames: vec![[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -0.5]]],
-                    w: crate::contact::solve::Delassus {
+                    w: adhesim::contact::solve::Delassus {
                         w: (0..9).map(|i| i as f64 * 1e-7).collect(),
                         m: 3,
                     },
@@ -575,7 +575,7 @@ mod tests {
         assert_ne!(old, c.clone().encode());
         let d = Checkpoint::decode(&old).unwrap();
         assert!(bits_equal(&c, &d));
-        let h = crate::contact::RccHistory::decode(&d.snapshot.contact[0][0].history);
+        let h = adhesim::contact::RccHistory::decode(&d.snapshot.contact[0][0].history);
         assert_eq!((h.beta, h.ut, h.damage), (0.25, [1e-9, -2e-9, 0.0], 0.125));
     }
 
@@ -594,14 +594,14 @@ mod tests {
 
     #[test]
     fn fingerprint_sees_a_changed_number() {
-        let time = crate::problem::TimeSettings::default();
+        let time = adhesim::problem::TimeSettings::default();
         let problem = |t_end: f64| Problem {
             name: "p".into(),
             bodies: vec![],
             dirichlet: vec![],
             loads: vec![],
             gravity: Default::default(),
-            time: crate::problem::TimeSettings {
+            time: adhesim::problem::TimeSettings {
                 t_end,
                 ..time.clone()
             },
