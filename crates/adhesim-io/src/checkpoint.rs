@@ -3,8 +3,8 @@
 //! A checkpoint holds the stepper's [`Snapshot`] (time, step counter, u, v, the committed
 //! contact state, the internal variables of viscoelastic materials, the current Δt and its
 //! cut-back bookkeeping, the energy accumulators, the forces at the start of the next step
-//! and the Delassus operator the Gauss-Seidel contact solve keeps for reuse), how far the
-//! outputs got (frames written, the next frame time, the PVD entries, history rows) and the
+//! and the Delassus operator the Gauss-Seidel contact solve keeps for reuse), the resume
+//! state of each output ([`crate::output::Observer::resume_state`], opaque here) and the
 //! run's counters. It is tied to the problem it was written for by a fingerprint, so that
 //! resuming with a changed scenario is refused.
 //!
@@ -13,8 +13,9 @@
 //! and last an FNV-1a 64 checksum of everything before it. The file is replaced atomically
 //! (see [`crate::output::atomic`]), so there is always one complete checkpoint: the last.
 
+use crate::codec::{Codec, Dec, Enc};
 use crate::output::settings::OutputSettings;
-use crate::output::FrameProgress;
+use crate::output::{FrameProgress, HistoryObserver, SavedObserver, FRAMES_KEY, HISTORY_KEY};
 use adhesim::contact::history::MAX_HISTORY_VALUES;
 use adhesim::problem::Problem;
 use adhesim::time::{CachedDelassus, DelassusCache, NodeContact, Snapshot};
@@ -26,10 +27,17 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 
 const MAGIC: &[u8; 8] = b"ADHCKPT\0";
 /// The checkpoint format this version writes.
-pub const FORMAT: u32 = 6;
-/// The previous format, still read: the layout of [`FORMAT`], written by builds whose
+pub const FORMAT: u32 = 7;
+/// The first format with the observers' own resume states ([`SavedObserver`]).
+const FORMAT_OBSERVER_STATES: u32 = 7;
+/// The previous format, still read and resumed (its fingerprint is this build's): the frame
+/// writer's progress and the rows of history.csv in fixed fields where the observers' states
+/// are now.
+const FORMAT_FIXED_OUTPUTS: u32 = 6;
+/// The format before, still read: the layout of format 6, written by builds whose
 /// fingerprint hashed the output settings as part of the problem (so their fingerprints
 /// differ from this build's for the same scenario).
+#[cfg_attr(not(test), allow(dead_code))]
 const FORMAT_OUTPUT_IN_PROBLEM: u32 = 5;
 /// The format before that, still read: it stored the RCC law's history (β, u_t, D), the only
 /// law then, among each contact node's other values.
@@ -46,10 +54,8 @@ pub struct Checkpoint {
     pub format: u32,
     /// The stepper's state.
     pub snapshot: Snapshot,
-    /// How far the frame writer got.
-    pub frames: FrameProgress,
-    /// Rows of history.csv written (the row at t = 0 included).
-    pub history_rows: u64,
+    /// The resume state of each of the run's observers ([`crate::output::Observer`]).
+    pub observers: Vec<SavedObserver>,
     /// Discarded attempts so far.
     pub cutbacks: usize,
     /// Newton iterations so far.
@@ -143,6 +149,14 @@ impl Checkpoint {
         Self::decode(&bytes).map_err(|reason| CheckpointError::Corrupt { path, reason })
     }
 
+    /// The resume state saved by the observer whose key is `key`, if any.
+    pub fn observer_state(&self, key: &str) -> Option<&[u8]> {
+        self.observers
+            .iter()
+            .find(|o| o.key == key)
+            .map(|o| &o.state[..])
+    }
+
     /// Checks that the checkpoint in `dir` was written by this version for the run whose
     /// [`fingerprint`] is `fingerprint`.
     pub fn check_matches(&self, fingerprint: u64, dir: &Path) -> Result<(), CheckpointError> {
@@ -162,13 +176,13 @@ impl Checkpoint {
             // The fingerprint hashes the problem as this build describes it; the builds that
             // wrote an older format described the same scenario differently, so a mismatch
             // there says nothing about the scenario.
-            let reason = if self.format != FORMAT {
+            let reason = if self.format < FORMAT_FIXED_OUTPUTS {
                 format!(
                     "it was written in checkpoint format {} by an earlier build of adhesim \
                      {version}, whose description of a scenario differs from this build's \
                      even when the scenario file is the same; finish the run with the build \
                      that started it, or start it again (this build resumes checkpoints of \
-                     format {FORMAT})",
+                     formats {FORMAT_FIXED_OUTPUTS} and {FORMAT})",
                     self.format
                 )
             } else {
@@ -219,7 +233,7 @@ impl Checkpoint {
             pos: MAGIC.len(),
         };
         let format = u32::from_le_bytes(r.take(4)?.try_into().unwrap());
-        if ![FORMAT, FORMAT_OUTPUT_IN_PROBLEM, FORMAT_RCC_ONLY].contains(&format) {
+        if !(FORMAT_RCC_ONLY..=FORMAT).contains(&format) {
             return Err(format!(
                 "format {format}, but this version of adhesim reads formats \
                  {FORMAT_RCC_ONLY} to {FORMAT}"
@@ -244,12 +258,7 @@ impl Checkpoint {
                 material_history: Vec::new(),
                 delassus: None,
             },
-            frames: FrameProgress {
-                frames: 0,
-                next_time: 0.0,
-                entries: Vec::new(),
-            },
-            history_rows: 0,
+            observers: Vec::new(),
             cutbacks: 0,
             newton_iterations: 0,
             wall_time: 0.0,
@@ -314,19 +323,51 @@ impl Checkpoint {
         }
         c.f64s(&mut s.material_history)?;
         delassus(c, &mut s.delassus)?;
-        let f = &mut self.frames;
-        c.usize(&mut f.frames)?;
-        c.f64(&mut f.next_time)?;
-        c.count(&mut f.entries, 16)?;
-        for e in &mut f.entries {
-            c.f64(&mut e.time)?;
-            c.str(&mut e.file)?;
+        if format >= FORMAT_OBSERVER_STATES {
+            c.count(&mut self.observers, 16)?;
+            for o in &mut self.observers {
+                c.str(&mut o.key)?;
+                c.bytes(&mut o.state)?;
+            }
+        } else {
+            legacy_observers(c, &mut self.observers)?;
         }
-        c.u64(&mut self.history_rows)?;
         c.usize(&mut self.cutbacks)?;
         c.usize(&mut self.newton_iterations)?;
         c.f64(&mut self.wall_time)
     }
+}
+
+/// The observers' states as formats 4 to 6 held them: the frame writer's progress inline,
+/// then the rows of history.csv; the contact maps kept none (they resume from the time).
+fn legacy_observers(c: &mut impl Codec, observers: &mut Vec<SavedObserver>) -> Result<(), String> {
+    let saved = |key: &str| {
+        observers
+            .iter()
+            .find(|o| o.key == key)
+            .map(|o| &o.state[..])
+    };
+    let mut frames = match saved(FRAMES_KEY) {
+        Some(s) => FrameProgress::from_bytes(s)?,
+        None => FrameProgress::default(),
+    };
+    let mut rows = match saved(HISTORY_KEY) {
+        Some(s) => HistoryObserver::rows_in_state(s)?,
+        None => 0,
+    };
+    frames.visit(c)?;
+    c.u64(&mut rows)?;
+    *observers = vec![
+        SavedObserver {
+            key: FRAMES_KEY.into(),
+            state: frames.to_bytes(),
+        },
+        SavedObserver {
+            key: HISTORY_KEY.into(),
+            state: HistoryObserver::state_of_rows(rows),
+        },
+    ];
+    Ok(())
 }
 
 /// The contact nodes of a pair in format 4: per node β, u_t (3), then the
@@ -373,116 +414,6 @@ fn delassus(c: &mut impl Codec, cache: &mut DelassusCache) -> Result<(), String>
         return Err("the Delassus operator's sizes do not agree".into());
     }
     Ok(())
-}
-
-/// One direction of the checkpoint's byte format: [`Enc`] writes each value it is shown,
-/// [`Dec`] overwrites it with the next value read.
-trait Codec {
-    fn u64(&mut self, x: &mut u64) -> Result<(), String>;
-    fn i32(&mut self, x: &mut i32) -> Result<(), String>;
-    /// A count, then resizes `items` to it (reading) or writes their number (writing);
-    /// each item takes at least `item_bytes` bytes (checked against what is left).
-    fn count<T: Clone + Default>(
-        &mut self,
-        items: &mut Vec<T>,
-        item_bytes: usize,
-    ) -> Result<(), String>;
-    fn bytes(&mut self, x: &mut Vec<u8>) -> Result<(), String>;
-
-    fn usize(&mut self, x: &mut usize) -> Result<(), String> {
-        let mut v = *x as u64;
-        self.u64(&mut v)?;
-        *x = usize::try_from(v).map_err(|_| "a count does not fit in memory".to_string())?;
-        Ok(())
-    }
-    fn f64(&mut self, x: &mut f64) -> Result<(), String> {
-        let mut bits = x.to_bits();
-        self.u64(&mut bits)?;
-        *x = f64::from_bits(bits);
-        Ok(())
-    }
-    fn f64s(&mut self, x: &mut Vec<f64>) -> Result<(), String> {
-        self.count(x, 8)?;
-        x.iter_mut().try_for_each(|v| self.f64(v))
-    }
-    fn str(&mut self, s: &mut String) -> Result<(), String> {
-        let mut b = std::mem::take(s).into_bytes();
-        self.bytes(&mut b)?;
-        *s = String::from_utf8(b).map_err(|_| "a name is not UTF-8".to_string())?;
-        Ok(())
-    }
-}
-
-struct Enc(Vec<u8>);
-
-impl Codec for Enc {
-    fn u64(&mut self, x: &mut u64) -> Result<(), String> {
-        self.0.extend_from_slice(&x.to_le_bytes());
-        Ok(())
-    }
-    fn i32(&mut self, x: &mut i32) -> Result<(), String> {
-        self.0.extend_from_slice(&x.to_le_bytes());
-        Ok(())
-    }
-    fn count<T: Clone + Default>(&mut self, items: &mut Vec<T>, _: usize) -> Result<(), String> {
-        self.u64(&mut (items.len() as u64))
-    }
-    fn bytes(&mut self, x: &mut Vec<u8>) -> Result<(), String> {
-        self.u64(&mut (x.len() as u64))?;
-        self.0.extend_from_slice(x);
-        Ok(())
-    }
-}
-
-struct Dec<'a> {
-    bytes: &'a [u8],
-    pos: usize,
-}
-
-impl Dec<'_> {
-    fn take(&mut self, n: usize) -> Result<&[u8], String> {
-        if self.bytes.len() - self.pos < n {
-            return Err(format!("it ends early (at byte {})", self.pos));
-        }
-        let s = &self.bytes[self.pos..self.pos + n];
-        self.pos += n;
-        Ok(s)
-    }
-    /// A count of items of at least `item_bytes` bytes each, checked against what is left.
-    fn len(&mut self, item_bytes: usize) -> Result<usize, String> {
-        let mut n = 0;
-        self.usize(&mut n)?;
-        if n.saturating_mul(item_bytes) > self.bytes.len() - self.pos {
-            return Err(format!("a count ({n}) exceeds the file's size"));
-        }
-        Ok(n)
-    }
-}
-
-impl Codec for Dec<'_> {
-    fn u64(&mut self, x: &mut u64) -> Result<(), String> {
-        *x = u64::from_le_bytes(self.take(8)?.try_into().unwrap());
-        Ok(())
-    }
-    fn i32(&mut self, x: &mut i32) -> Result<(), String> {
-        *x = i32::from_le_bytes(self.take(4)?.try_into().unwrap());
-        Ok(())
-    }
-    fn count<T: Clone + Default>(
-        &mut self,
-        items: &mut Vec<T>,
-        item_bytes: usize,
-    ) -> Result<(), String> {
-        let n = self.len(item_bytes)?;
-        items.clear();
-        items.resize(n, T::default());
-        Ok(())
-    }
-    fn bytes(&mut self, x: &mut Vec<u8>) -> Result<(), String> {
-        let n = self.len(1)?;
-        *x = self.take(n)?.to_vec();
-        Ok(())
-    }
 }
 
 #[cfg(test)]
@@ -533,15 +464,24 @@ mod tests {
                     },
                 }),
             },
-            frames: FrameProgress {
-                frames: 3,
-                next_time: 0.30000000000000004,
-                entries: vec![PvdEntry {
-                    time: 0.0,
-                    file: "vtu/é_00000.vtu".into(),
-                }],
-            },
-            history_rows: 8,
+            observers: vec![
+                SavedObserver {
+                    key: FRAMES_KEY.into(),
+                    state: FrameProgress {
+                        frames: 3,
+                        next_time: 0.30000000000000004,
+                        entries: vec![PvdEntry {
+                            time: 0.0,
+                            file: "vtu/é_00000.vtu".into(),
+                        }],
+                    }
+                    .to_bytes(),
+                },
+                SavedObserver {
+                    key: HISTORY_KEY.into(),
+                    state: HistoryObserver::state_of_rows(8),
+                },
+            ],
             cutbacks: 2,
             newton_iterations: 31,
             wall_time: 1.25,
@@ -562,7 +502,38 @@ mod tests {
         assert!(d.snapshot.contact[0][0].gap.is_nan());
         assert_eq!(d.snapshot.contact[0][0].tangent_axes[1][1], 1.0 / 3.0);
         assert_eq!(d.snapshot.u[1].to_bits(), (-0.0f64).to_bits());
-        assert_eq!(d.frames.entries[0].file, "vtu/é_00000.vtu");
+        let frames = FrameProgress::from_bytes(&d.observers[0].state).unwrap();
+        assert_eq!(frames.entries[0].file, "vtu/é_00000.vtu");
+        assert_eq!(HistoryObserver::rows_in_state(&d.observers[1].state), Ok(8));
+    }
+
+    /// An observer's state is carried as it is, whatever it holds: the checkpoint does not
+    /// read it.
+    #[test]
+    fn any_observer_state_round_trips() {
+        let mut c = sample();
+        c.observers.push(SavedObserver {
+            key: "probe".into(),
+            state: vec![0, 255, 7],
+        });
+        c.observers.push(SavedObserver::default());
+        let d = Checkpoint::decode(&c.clone().encode()).unwrap();
+        assert_eq!(d.observers, c.observers);
+    }
+
+    /// Format 6 held the frame writer's progress and the history's rows in fixed fields; it
+    /// is read into the same observer states (the maps, which it did not hold, resume from
+    /// the time), and its fingerprint is this build's, so such a run goes on.
+    #[test]
+    fn format_6_is_read_into_observer_states() {
+        let c = sample();
+        let six = c.clone().encode_as(FORMAT_FIXED_OUTPUTS);
+        assert_eq!(&six[8..12], &6u32.to_le_bytes());
+        assert_ne!(six, c.clone().encode());
+        let d = Checkpoint::decode(&six).unwrap();
+        assert_eq!(d.format, FORMAT_FIXED_OUTPUTS);
+        assert_eq!(d.observers, c.observers);
+        assert!(d.check_matches(c.fingerprint, Path::new("out")).is_ok());
     }
 
     /// Format 4 (the RCC law's history among the node's values) is still read, to the same
@@ -644,7 +615,7 @@ mod tests {
             "{err}"
         );
         assert!(err.contains("out/p/checkpoint.bin"), "{err}");
-        // Format 5 has this layout but hashed the output settings inside the problem.
+        // Format 5 has format 6's layout but hashed the output settings inside the problem.
         let five = Checkpoint::decode(&sample().encode_as(FORMAT_OUTPUT_IN_PROBLEM)).unwrap();
         assert!(
             five.clone().encode() == current.clone().encode(),

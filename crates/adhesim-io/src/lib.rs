@@ -7,6 +7,7 @@
 //! scenarios. Data flows one way: nothing in `adhesim` calls into this crate.
 
 pub mod checkpoint;
+mod codec;
 pub mod outdir;
 pub mod output;
 pub mod run;

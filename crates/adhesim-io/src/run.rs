@@ -13,9 +13,8 @@
 //! only written over on request (see [`crate::outdir`]).
 
 use crate::checkpoint::{fingerprint, Checkpoint, CheckpointError};
-use crate::output::maps::MapObserver;
 use crate::output::plot::PlotError;
-use crate::output::{FrameWriter, HistoryObserver, Observer, StepView};
+use crate::output::{resume_observers, start_observers, Observer, SavedObserver, StepView};
 use crate::scenario::Scenario;
 use adhesim::time::{SetupError, StepReport, Stepper};
 use std::path::{Path, PathBuf};
@@ -217,7 +216,7 @@ pub fn run_with(
         checkpoint: None,
     };
     let mut wall_before = 0.0;
-    let (mut frames, mut history, mut maps) = match resume_from {
+    let mut observers = match resume_from {
         Some(c) => {
             let at = CheckpointInfo {
                 step: c.snapshot.step,
@@ -241,25 +240,10 @@ pub fn run_with(
                     crate::output::atomic::remove_stale_temps(&d).map_err(io_err)?;
                 }
             }
-            let frames =
-                FrameWriter::resume(out_dir, &problem.name, output.frame_interval, c.frames)
-                    .map_err(io_err)?;
-            let history = HistoryObserver::resume(
-                &out_dir.join("history.csv"),
-                &problem,
-                &output,
-                c.history_rows,
-            )
-            .map_err(io_err)?;
-            let maps = MapObserver::resume(out_dir, &output.maps, at.t).map_err(io_err)?;
-            (frames, history, maps)
+            resume_observers(out_dir, &problem, &output, &c.observers, at.t).map_err(io_err)?
         }
         None => {
-            let mut frames =
-                FrameWriter::new(out_dir, &problem.name, output.frame_interval).map_err(io_err)?;
-            let mut history = HistoryObserver::new(&out_dir.join("history.csv"), &problem, &output)
-                .map_err(io_err)?;
-            let mut maps = MapObserver::new(out_dir, &output.maps).map_err(io_err)?;
+            let mut observers = start_observers(out_dir, &problem, &output).map_err(io_err)?;
             let initial = StepReport {
                 internal: 0.0,
                 kinetic: stepper.kinetic_energy(&stepper.state.v),
@@ -273,32 +257,34 @@ pub fn run_with(
                 contact: &stepper.contact,
                 reactions: stepper.reactions(),
             };
-            frames.observe(&view).map_err(io_err)?;
-            history.observe(&view).map_err(io_err)?;
-            maps.observe(&view).map_err(io_err)?;
-            (frames, history, maps)
+            observe(&mut observers, &view).map_err(io_err)?;
+            observers
         }
     };
-    let update = |summary: &mut RunSummary, stepper: &Stepper, frames: &FrameWriter| {
+    let update = |summary: &mut RunSummary, stepper: &Stepper, observers: &[Box<dyn Observer>]| {
         summary.t_reached = stepper.state.t;
-        summary.frames = frames.frames();
+        summary.frames = observers.iter().map(|o| o.frames_written()).sum();
         summary.wall_time = wall_before + start.elapsed().as_secs_f64();
     };
-    update(&mut summary, &stepper, &frames);
+    update(&mut summary, &stepper, &observers);
     write_summary(out_dir, &summary).map_err(io_err)?;
     let save = |summary: &mut RunSummary,
                 stepper: &Stepper,
-                frames: &FrameWriter,
-                history: &HistoryObserver|
+                observers: &[Box<dyn Observer>]|
      -> Result<(), RunError> {
-        update(summary, stepper, frames);
+        update(summary, stepper, observers);
         let c = Checkpoint {
             version: summary.version.clone(),
             fingerprint,
             format: crate::checkpoint::FORMAT,
             snapshot: stepper.snapshot(),
-            frames: frames.progress(),
-            history_rows: history.rows_written(),
+            observers: observers
+                .iter()
+                .map(|o| SavedObserver {
+                    key: o.key().to_string(),
+                    state: o.resume_state(),
+                })
+                .collect(),
             cutbacks: summary.cutbacks,
             newton_iterations: summary.newton_iterations,
             wall_time: summary.wall_time,
@@ -318,7 +304,7 @@ pub fn run_with(
             if control.stop_requested(stepper.state.step) {
                 summary.outcome = Outcome::Interrupted;
                 if summary.checkpoint.map(|c| c.step) != Some(stepper.state.step) {
-                    save(&mut summary, &stepper, &frames, &history)?;
+                    save(&mut summary, &stepper, &observers)?;
                 }
                 return Ok(());
             }
@@ -335,13 +321,11 @@ pub fn run_with(
                         contact: &stepper.contact,
                         reactions: stepper.reactions(),
                     };
-                    frames.observe(&view).map_err(io_err)?;
-                    history.observe(&view).map_err(io_err)?;
-                    maps.observe(&view).map_err(io_err)?;
+                    observe(&mut observers, &view).map_err(io_err)?;
                     progress.step(&report, problem.time.t_end);
                     let every = control.checkpoint_every;
                     if every > 0 && stepper.state.step % every == 0 && !stepper.finished() {
-                        save(&mut summary, &stepper, &frames, &history)?;
+                        save(&mut summary, &stepper, &observers)?;
                     }
                 }
                 Err(e) => {
@@ -368,7 +352,7 @@ pub fn run_with(
             progress.message(&format!("figures not drawn: {e}"));
         }
     }
-    update(&mut summary, &stepper, &frames);
+    update(&mut summary, &stepper, &observers);
     if let Err(e) = result {
         // Leave a run.json that says why the run stopped (best effort: the error may well be
         // that nothing can be written).
@@ -378,6 +362,11 @@ pub fn run_with(
     }
     write_summary(out_dir, &summary).map_err(io_err)?;
     Ok(summary)
+}
+
+/// Hands `view` to every observer, in order.
+fn observe(observers: &mut [Box<dyn Observer>], view: &StepView) -> std::io::Result<()> {
+    observers.iter_mut().try_for_each(|o| o.observe(view))
 }
 
 /// Writes `DIR/run.json` atomically.

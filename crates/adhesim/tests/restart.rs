@@ -5,16 +5,19 @@
 use adhesim::contact::RccHistory;
 use adhesim_io::checkpoint::{Checkpoint, CheckpointError};
 use adhesim_io::output::csv::read_history;
+use adhesim_io::output::{HistoryObserver, HISTORY_KEY};
 use adhesim_io::run::{run_with, Outcome, RunControl, RunError, Silent};
 use adhesim_io::scenario::Scenario;
 use std::path::{Path, PathBuf};
 
 /// The shipped indentation scenario, coarsened and cut to its loading phase (1 s, 50 steps):
-/// contact from the first step, bonds forming (β → 1) at the centre and growing outwards.
+/// contact from the first step, bonds forming (β → 1) at the centre and growing outwards;
+/// with contact maps at three times, one of them before the checkpoints of the tests.
 fn problem(w: f64) -> Scenario {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/indentation.toml");
-    let text = std::fs::read_to_string(&path)
-        .unwrap()
+    let maps = "\n[[map]]\ncontact = \"indentor\"\nfields = [\"beta\", \"pn\"]\n\
+                times = [0.05, 0.5, 0.9]\n";
+    let text = (std::fs::read_to_string(&path).unwrap() + maps)
         .replace("t_end = 4.0", "t_end = 1.0")
         .replace("divisions = [60, 6, 1]", "divisions = [30, 3, 1]")
         .replace("w = 20.0", &format!("w = {w:?}"));
@@ -52,9 +55,29 @@ fn assert_same_history(a: &Path, b: &Path) {
     }
 }
 
-/// Asserts that the frame collections and every frame file agree byte for byte; returns the
-/// number of frames (multiblock files).
+/// Asserts that the frame collections, every frame file and every contact map agree byte
+/// for byte; returns the number of frames (multiblock files).
 fn assert_same_frames(a: &Path, b: &Path) -> usize {
+    let maps = |d: &Path| {
+        let mut v: Vec<_> = std::fs::read_dir(d.join("maps"))
+            .unwrap()
+            .map(|e| {
+                let e = e.unwrap();
+                (e.file_name(), std::fs::read(e.path()).unwrap())
+            })
+            .collect();
+        v.sort();
+        v
+    };
+    let written = maps(a);
+    // The faces and one file per requested time.
+    assert_eq!(
+        written.len(),
+        4,
+        "{:?}",
+        written.iter().map(|m| &m.0).collect::<Vec<_>>()
+    );
+    assert!(written == maps(b), "the contact maps differ");
     let pvd = "indentation.pvd";
     assert_eq!(
         std::fs::read_to_string(a.join(pvd)).unwrap(),
@@ -109,7 +132,8 @@ fn stopped_and_resumed_run_equals_the_uninterrupted_one() {
     assert_eq!(s.steps, 7);
     let c = Checkpoint::read(&part).unwrap();
     assert_eq!(c.snapshot.step, 7);
-    assert_eq!(c.history_rows, 8);
+    let history = c.observer_state(HISTORY_KEY).unwrap();
+    assert_eq!(HistoryObserver::rows_in_state(history), Ok(8));
     let json = std::fs::read_to_string(part.join("run.json")).unwrap();
     assert!(json.contains("\"interrupted\""), "{json}");
     // The centre is already bonded: the restart carries real adhesion state.

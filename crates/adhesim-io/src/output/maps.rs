@@ -10,7 +10,10 @@
 
 use super::csv::read_history;
 use super::plot::{draw_scalar_map_with, ColorMap, PlotError, ScalarMap, ScalarValues};
-use super::{contact_node_fields, contact_node_values, Observer, StepView, CONTACT_NODE_FIELDS};
+use super::{
+    contact_node_fields, contact_node_values, Observer, StepView, CONTACT_NODE_FIELDS, MAPS_KEY,
+};
+use crate::codec::{Codec, Dec, Enc};
 use crate::output::settings::MapRequest;
 use adhesim::contact::history::{self, FieldKind, HistoryField};
 use adhesim::contact::Interface;
@@ -74,18 +77,75 @@ impl MapObserver {
 }
 
 impl MapObserver {
-    /// Goes on after a checkpoint at time `t`: the maps of earlier times are written.
-    pub fn resume(dir: &Path, requests: &[MapRequest], t: f64) -> io::Result<Self> {
+    /// Goes on after a checkpoint at time `t` [s] from the resume state `state`: the maps of
+    /// earlier times are written. Without a state (checkpoints of format 6 and earlier) the
+    /// maps due up to `t` count as written.
+    pub fn resume(
+        dir: &Path,
+        requests: &[MapRequest],
+        state: Option<&[u8]>,
+        t: f64,
+    ) -> io::Result<Self> {
         let mut m = MapObserver::new(dir, requests)?;
-        for (r, req) in requests.iter().enumerate() {
-            m.next[r] = req
-                .times
-                .iter()
-                .filter(|&&w| t >= w - 1e-9 * w.abs())
-                .count();
-            m.faces_written[r] = true;
+        match state {
+            Some(bytes) => {
+                m.read_state(bytes).map_err(|reason| {
+                    io::Error::new(
+                        io::ErrorKind::InvalidData,
+                        format!(
+                            "the {MAPS_KEY} output's resume state in the checkpoint is \
+                             damaged: {reason}"
+                        ),
+                    )
+                })?;
+            }
+            None => {
+                for (r, req) in requests.iter().enumerate() {
+                    m.next[r] = req
+                        .times
+                        .iter()
+                        .filter(|&&w| t >= w - 1e-9 * w.abs())
+                        .count();
+                    m.faces_written[r] = true;
+                }
+            }
         }
         Ok(m)
+    }
+
+    /// Per request the next time index and whether its faces are written, through `c`.
+    fn visit(
+        next: &mut Vec<usize>,
+        faces: &mut Vec<bool>,
+        c: &mut impl Codec,
+    ) -> Result<(), String> {
+        c.count(next, 16)?;
+        faces.resize(next.len(), false);
+        for (n, f) in next.iter_mut().zip(faces.iter_mut()) {
+            c.usize(n)?;
+            let mut written = usize::from(*f);
+            c.usize(&mut written)?;
+            *f = written != 0;
+        }
+        Ok(())
+    }
+
+    /// Reads the state written by [`Observer::resume_state`] into `self`, which must have as
+    /// many requests.
+    fn read_state(&mut self, bytes: &[u8]) -> Result<(), String> {
+        let (mut next, mut faces) = (Vec::new(), Vec::new());
+        let mut d = Dec::new(bytes);
+        Self::visit(&mut next, &mut faces, &mut d)?;
+        d.finish()?;
+        if next.len() != self.requests.len() {
+            return Err(format!(
+                "it holds {} map requests, the scenario {}",
+                next.len(),
+                self.requests.len()
+            ));
+        }
+        (self.next, self.faces_written) = (next, faces);
+        Ok(())
     }
 }
 
@@ -95,6 +155,21 @@ fn map_stem(pair: &str, t: f64) -> String {
 }
 
 impl Observer for MapObserver {
+    fn key(&self) -> &'static str {
+        MAPS_KEY
+    }
+
+    fn resume_state(&self) -> Vec<u8> {
+        let mut e = Enc(Vec::new());
+        Self::visit(
+            &mut self.next.clone(),
+            &mut self.faces_written.clone(),
+            &mut e,
+        )
+        .expect("writing to memory cannot fail");
+        e.0
+    }
+
     fn observe(&mut self, view: &StepView) -> io::Result<()> {
         let t = view.state.t;
         for (r, req) in self.requests.iter().enumerate() {

@@ -9,6 +9,7 @@ pub mod plot;
 pub mod settings;
 pub mod vtk;
 
+use crate::codec::{Codec, Dec, Enc};
 use adhesim::assembly::Discretisation;
 use adhesim::contact::history::{FieldKind, HistoryField, Slot};
 use adhesim::contact::{Interface, Master, RigidShape};
@@ -37,10 +38,107 @@ pub struct StepView<'a> {
     pub reactions: &'a [f64],
 }
 
-/// Records a run.
+/// Records a run. A run hands every committed step (and t = 0) to a list of observers
+/// ([`start_observers`]); each saves what it needs to go on after a restart
+/// ([`Observer::resume_state`]) and reads it back itself ([`resume_observers`]), so the
+/// checkpoint stores the states without knowing what they hold.
 pub trait Observer {
+    /// Its name in a checkpoint, unique among a run's observers.
+    fn key(&self) -> &'static str;
+
     /// Called at t = 0 and after every committed step.
     fn observe(&mut self, view: &StepView) -> io::Result<()>;
+
+    /// What it needs to go on after a restart, in a byte format that only it reads back.
+    fn resume_state(&self) -> Vec<u8>;
+
+    /// VTU frames written so far (the run summary's count); 0 for observers that write none.
+    fn frames_written(&self) -> usize {
+        0
+    }
+}
+
+/// An observer's resume state as a checkpoint keeps it.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SavedObserver {
+    /// [`Observer::key`] of the observer that saved it.
+    pub key: String,
+    /// Its [`Observer::resume_state`].
+    pub state: Vec<u8>,
+}
+
+/// Key of the [`FrameWriter`].
+pub const FRAMES_KEY: &str = "frames";
+/// Key of the [`HistoryObserver`].
+pub const HISTORY_KEY: &str = "history";
+/// Key of the [`maps::MapObserver`].
+pub const MAPS_KEY: &str = "maps";
+
+/// The observers of a new run in `dir`: the VTU frames, history.csv and the contact maps,
+/// each with its files created.
+pub fn start_observers(
+    dir: &Path,
+    problem: &Problem,
+    output: &OutputSettings,
+) -> io::Result<Vec<Box<dyn Observer>>> {
+    Ok(vec![
+        Box::new(FrameWriter::new(dir, &problem.name, output.frame_interval)?),
+        Box::new(HistoryObserver::new(
+            &dir.join("history.csv"),
+            problem,
+            output,
+        )?),
+        Box::new(maps::MapObserver::new(dir, &output.maps)?),
+    ])
+}
+
+/// The observers of [`start_observers`] going on in `dir` from the states `saved` of a
+/// checkpoint at time `t` [s]. A state that is missing (the maps' in checkpoints of earlier
+/// formats) is rebuilt from `t` where the observer can, and is an error where it cannot.
+pub fn resume_observers(
+    dir: &Path,
+    problem: &Problem,
+    output: &OutputSettings,
+    saved: &[SavedObserver],
+    t: f64,
+) -> io::Result<Vec<Box<dyn Observer>>> {
+    let state = |key: &str| saved.iter().find(|s| s.key == key).map(|s| &s.state[..]);
+    let required = |key: &str| {
+        state(key).ok_or_else(|| {
+            io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("the checkpoint holds no resume state for the {key} output"),
+            )
+        })
+    };
+    Ok(vec![
+        Box::new(FrameWriter::resume(
+            dir,
+            &problem.name,
+            output.frame_interval,
+            required(FRAMES_KEY)?,
+        )?),
+        Box::new(HistoryObserver::resume(
+            &dir.join("history.csv"),
+            problem,
+            output,
+            required(HISTORY_KEY)?,
+        )?),
+        Box::new(maps::MapObserver::resume(
+            dir,
+            &output.maps,
+            state(MAPS_KEY),
+            t,
+        )?),
+    ])
+}
+
+/// An observer's resume state that cannot be read, as an I/O error of kind InvalidData.
+fn bad_state(key: &str, reason: String) -> io::Error {
+    io::Error::new(
+        io::ErrorKind::InvalidData,
+        format!("the {key} output's resume state in the checkpoint is damaged: {reason}"),
+    )
 }
 
 /// Writes a VTU frame per output interval and keeps the PVD collection up to date.
@@ -75,7 +173,7 @@ impl FrameWriter {
         self.frames
     }
 
-    /// What the writer needs to go on after a restart.
+    /// How far the writer got.
     pub fn progress(&self) -> FrameProgress {
         FrameProgress {
             frames: self.frames,
@@ -84,15 +182,13 @@ impl FrameWriter {
         }
     }
 
-    /// Continues a collection in `dir` after `progress`: the PVD is rewritten with its
-    /// entries, and frames numbered from `progress.frames` on (left by the interrupted run
-    /// after its checkpoint) are removed; they are written again as the run goes on.
-    pub fn resume(
-        dir: &Path,
-        name: &str,
-        interval: f64,
-        progress: FrameProgress,
-    ) -> io::Result<Self> {
+    /// Continues a collection in `dir` from the resume state `state` ([`FrameProgress`]'s
+    /// bytes): the PVD is rewritten with its entries, and frames numbered from its frame
+    /// count on (left by the interrupted run after its checkpoint) are removed; they are
+    /// written again as the run goes on.
+    pub fn resume(dir: &Path, name: &str, interval: f64, state: &[u8]) -> io::Result<Self> {
+        let progress =
+            FrameProgress::from_bytes(state).map_err(|reason| bad_state(FRAMES_KEY, reason))?;
         let vtu = dir.join("vtu");
         std::fs::create_dir_all(&vtu)?;
         let prefix = format!("{name}_");
@@ -116,8 +212,8 @@ impl FrameWriter {
     }
 }
 
-/// How far a [`FrameWriter`] got: saved in checkpoints.
-#[derive(Clone, Debug, PartialEq)]
+/// How far a [`FrameWriter`] got: its resume state.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct FrameProgress {
     /// Frames written.
     pub frames: usize,
@@ -125,6 +221,39 @@ pub struct FrameProgress {
     pub next_time: f64,
     /// Entries of the PVD collection.
     pub entries: Vec<vtk::PvdEntry>,
+}
+
+impl FrameProgress {
+    /// Its fields in order through `c` (the layout that checkpoints up to format 6 held
+    /// inline): frames, next time, then the PVD entries (time, file).
+    pub(crate) fn visit(&mut self, c: &mut impl Codec) -> Result<(), String> {
+        c.usize(&mut self.frames)?;
+        c.f64(&mut self.next_time)?;
+        c.count(&mut self.entries, 16)?;
+        for e in &mut self.entries {
+            c.f64(&mut e.time)?;
+            c.str(&mut e.file)?;
+        }
+        Ok(())
+    }
+
+    /// Its bytes, the [`FrameWriter`]'s resume state.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut e = Enc(Vec::new());
+        self.clone()
+            .visit(&mut e)
+            .expect("writing to memory cannot fail");
+        e.0
+    }
+
+    /// The progress whose [`FrameProgress::to_bytes`] are `bytes`; Err says what is wrong.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, String> {
+        let mut p = FrameProgress::default();
+        let mut d = Dec::new(bytes);
+        p.visit(&mut d)?;
+        d.finish()?;
+        Ok(p)
+    }
 }
 
 /// The frame number of a file name with the `<name>_` prefix removed: `NNNNN.vtm`,
@@ -205,6 +334,18 @@ fn body_frames(view: &StepView) -> Vec<BodyFrame> {
 }
 
 impl Observer for FrameWriter {
+    fn key(&self) -> &'static str {
+        FRAMES_KEY
+    }
+
+    fn resume_state(&self) -> Vec<u8> {
+        self.progress().to_bytes()
+    }
+
+    fn frames_written(&self) -> usize {
+        self.frames
+    }
+
     fn observe(&mut self, view: &StepView) -> io::Result<()> {
         let t = view.state.t;
         let last = t >= view.problem.time.t_end * (1.0 - 1e-12);
@@ -774,13 +915,15 @@ impl HistoryObserver {
 }
 
 impl HistoryObserver {
-    /// Continues `path` after its first `rows` rows (see [`csv::HistoryWriter::reopen`]).
+    /// Continues `path` after the rows its resume state `state` counts (see
+    /// [`csv::HistoryWriter::reopen`]).
     pub fn resume(
         path: &Path,
         problem: &Problem,
         output: &OutputSettings,
-        rows: u64,
+        state: &[u8],
     ) -> io::Result<Self> {
+        let rows = Self::rows_in_state(state).map_err(|reason| bad_state(HISTORY_KEY, reason))?;
         Ok(HistoryObserver {
             writer: csv::HistoryWriter::reopen(path, &history_columns(problem, output), rows)?,
             settings: output.clone(),
@@ -791,9 +934,31 @@ impl HistoryObserver {
     pub fn rows_written(&self) -> u64 {
         self.writer.rows_written()
     }
+
+    /// The resume state of a history with `rows` rows written (the row at t = 0 included).
+    pub fn state_of_rows(rows: u64) -> Vec<u8> {
+        rows.to_le_bytes().to_vec()
+    }
+
+    /// The rows counted by the resume state `state` ([`HistoryObserver::state_of_rows`]).
+    pub fn rows_in_state(state: &[u8]) -> Result<u64, String> {
+        let mut rows = 0;
+        let mut d = Dec::new(state);
+        d.u64(&mut rows)?;
+        d.finish()?;
+        Ok(rows)
+    }
 }
 
 impl Observer for HistoryObserver {
+    fn key(&self) -> &'static str {
+        HISTORY_KEY
+    }
+
+    fn resume_state(&self) -> Vec<u8> {
+        Self::state_of_rows(self.rows_written())
+    }
+
     fn observe(&mut self, view: &StepView) -> io::Result<()> {
         let r = view.report;
         let mut row = vec![
