@@ -498,7 +498,8 @@ pub fn solve_global(
     tol: f64,
     max_iter: usize,
 ) -> Result<ReducedSolution, String> {
-    use adhesim::contact::law::{BondState, InterfaceLaw, PointSolution};
+    use adhesim::contact::history::PointHistory;
+    use adhesim::contact::law::{InterfaceLaw, PointSolution};
     use adhesim::contact::mixed::{linearise_point, solve_mixed, LuDirection, MixedOperator};
     use adhesim::contact::natural_map::{natural_map_residual, relative_error};
     use std::collections::BTreeMap;
@@ -593,7 +594,7 @@ pub fn solve_global(
         .collect();
     let laws: Vec<InterfaceLaw> = p.mu.iter().map(|&mu| InterfaceLaw::coulomb(mu)).collect();
     let law = |c: usize, r: [f64; 3], x: [f64; 3]| {
-        linearise_point(&laws[c], BondState::default(), 1.0, 1.0, rho[c], r, x)
+        linearise_point(&laws[c], PointHistory::default(), 1.0, 1.0, rho[c], r, x)
     };
     let error = |pts: &[PointSolution]| {
         let r: Vec<[f64; 3]> = pts.iter().map(|s| s.r_dry.into()).collect();

@@ -26,7 +26,7 @@
 //! Run `cargo run --release --example bench_contact -- --help` for the options.
 
 use adhesim::contact::detect::{detect, ContactPoint};
-use adhesim::contact::law::BondState;
+use adhesim::contact::history::PointHistory;
 use adhesim::contact::solve::{delassus, gauss_seidel, Delassus};
 use adhesim::linalg::SparseCholesky;
 use adhesim::problem::Problem;
@@ -882,7 +882,7 @@ fn probe_sweep(
     }
     let del = Delassus { w, m };
     let laws: Vec<_> = stepper.problem.contacts.iter().map(|c| c.law).collect();
-    let bond0 = vec![BondState::default(); np];
+    let history0 = vec![PointHistory::default(); np];
     let x_free = vec![[0.0, 0.0, -1e-7]; np];
     let zero = vec![[0.0; 3]; np];
     let dt = stepper.next_dt();
@@ -891,7 +891,7 @@ fn probe_sweep(
         let clock = Instant::now();
         // A negative tolerance never settles: exactly `max_sweeps` sweeps.
         let sol = gauss_seidel(
-            points, &laws, &bond0, dt, &del, &x_free, &zero, &zero, -1.0, 3,
+            points, &laws, &history0, dt, &del, &x_free, &zero, &zero, -1.0, 3,
         );
         per_sweep.push(clock.elapsed().as_secs_f64() / sol.sweeps as f64);
     }

@@ -22,7 +22,8 @@ pub use constraints::{thickness_ties, Constraints};
 use crate::assembly::{BadElement, Discretisation};
 use crate::contact::detect::{align_frames, detect, ContactPoint};
 use crate::contact::history::NodeHistory;
-use crate::contact::law::{BondState, ContactState, Interface, PointSolution};
+use crate::contact::history::PointHistory;
+use crate::contact::law::{ContactState, Interface, PointSolution};
 use crate::contact::mixed::MixedWorkspace;
 use crate::linalg::LinalgError;
 use crate::problem::{ContactSolver, Problem};
@@ -472,7 +473,7 @@ impl Stepper {
             }
             match self.attempt(dt) {
                 Ok(a) => {
-                    self.commit_contact(&a.points, &a.solutions, &a.bond0);
+                    self.commit_contact(&a.points, &a.solutions, &a.history0);
                     self.reactions = a.reactions;
                     let (contact_sweeps, contact_points, timings, contact_residual) =
                         (a.sweeps, a.points.len(), a.timings, a.contact_residual);
@@ -531,7 +532,7 @@ impl Stepper {
         &mut self,
         points: &[ContactPoint],
         sols: &[PointSolution],
-        bond0: &[BondState],
+        history0: &[PointHistory],
     ) {
         // Nodes that are not candidates of this step keep what their law says.
         for (nodes, pair) in self.contact.iter_mut().zip(&self.problem.contacts) {
@@ -543,7 +544,7 @@ impl Stepper {
                 };
             }
         }
-        for ((pt, sol), b0) in points.iter().zip(sols).zip(bond0) {
+        for ((pt, sol), h0) in points.iter().zip(sols).zip(history0) {
             let f = &pt.frame;
             let r: [f64; 3] = sol.r().into();
             let global = |v: [f64; 3]| -> [f64; 3] {
@@ -553,7 +554,7 @@ impl Stepper {
             let share = pt.node_share();
             let part = |v: [f64; 3]| v.map(|c| share * c);
             let node = NodeContact {
-                history: self.problem.contacts[pt.pair].law.commit(b0, sol, f),
+                history: self.problem.contacts[pt.pair].law.commit(h0, sol, f),
                 r_dry: part(sol.r_dry.into()),
                 r_adh: part(sol.r_adh.into()),
                 force: part(global(r)),
@@ -573,7 +574,7 @@ impl Stepper {
     }
 
     /// Committed history of each contact point, frozen for the step, in its local frame.
-    fn bonds_at_start(&self, points: &[ContactPoint]) -> Vec<BondState> {
+    fn histories_at_start(&self, points: &[ContactPoint]) -> Vec<PointHistory> {
         points
             .iter()
             .map(|pt| {
@@ -674,10 +675,10 @@ impl Stepper {
         Err(newton.failure())
     }
 
-    /// Stage *detect*: the contact candidates over [t, t1] with their committed bond state,
-    /// the force their bonds can carry, ‖(A_α √(C w))_α‖ [N] (the force scale of an
-    /// interface that holds, or snaps into, contact without load), and, for the Newton
-    /// contact solve, the multipliers it starts from.
+    /// Stage *detect*: the contact candidates over [t, t1] with their laws' histories frozen
+    /// at the start of the step, the force their bonds can carry, ‖(A_α √(C w))_α‖ [N] (the
+    /// force scale of an interface that holds, or snaps into, contact without load), and, for
+    /// the Newton contact solve, the multipliers it starts from.
     fn detect_contact(&self, t1: f64) -> Candidates {
         let mut points = if self.problem.contacts.is_empty() {
             Vec::new()
@@ -708,7 +709,7 @@ impl Stepper {
             multipliers: (solver != ContactSolver::GaussSeidel)
                 .then(|| self.multipliers_at_start(&points)),
             solver,
-            bond0: self.bonds_at_start(&points),
+            history0: self.histories_at_start(&points),
             points,
             bond_strength,
         }

@@ -8,6 +8,7 @@
 //! total normal force, whatever the pressure distribution.
 
 use adhesim::contact::anisotropic::{sliding_friction, Orthotropy};
+use adhesim::contact::history::{LawPointHistory, PointHistory};
 use adhesim::contact::law::{
     adhesive_response, natural_map_defect, solve_point, BondState, InterfaceLaw, PointProblem,
     RccParams,
@@ -121,7 +122,7 @@ fn sliding_point_lands_on_the_ellipse_with_the_maximal_dissipation_direction() {
             w_aa: Mat3::from_diagonal_element(c),
             x_free,
             law: &l,
-            bond0: BondState::default(),
+            history0: PointHistory::default(),
             dt: 1e-3,
             area: 1e-6,
             rho: 1.0 / c,
@@ -147,7 +148,7 @@ fn sliding_point_lands_on_the_ellipse_with_the_maximal_dissipation_direction() {
         // The Newton solve's law agrees at the same x with λ = r̄ (a fixed point).
         let ap = augmented_point(
             &l,
-            BondState::default(),
+            PointHistory::default(),
             1e-3,
             1e-6,
             1.0 / c,
@@ -200,7 +201,7 @@ fn equal_coefficients_reproduce_the_isotropic_law() {
             w_aa: w,
             x_free,
             law,
-            bond0,
+            history0: bond0.encode(),
             dt: 1e-3,
             area: 1e-6,
             rho: 0.0,
@@ -228,7 +229,7 @@ fn orthotropic_adhesion_stiffness_per_axis() {
         let mut x = Vec3::zeros();
         x[k] = u;
         let r = adhesive_response(&rcc, bond, 1e-3, area, x);
-        assert_eq!(r.beta, 1.0);
+        assert_eq!(BondState::from(&r.history).beta, 1.0);
         let expect = -ct * u * area;
         assert!(
             (r.force[k] - expect).abs() < 1e-12 * expect.abs(),

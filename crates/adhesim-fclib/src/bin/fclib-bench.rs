@@ -18,7 +18,8 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use adhesim::contact::detect::ContactPoint;
-use adhesim::contact::law::{BondState, InterfaceLaw};
+use adhesim::contact::history::PointHistory;
+use adhesim::contact::law::InterfaceLaw;
 use adhesim::contact::reduced::{error_of, gauss_seidel_blocks, ReducedSolution};
 use adhesim::contact::semismooth::{proximal_newton, semismooth_newton};
 use adhesim::contact::solve::{gauss_seidel, Delassus};
@@ -127,13 +128,13 @@ fn nsgs_dense(p: &ReducedProblem, del: &Delassus, tol: f64, max_iter: usize) -> 
         })
         .collect();
     let laws: Vec<InterfaceLaw> = p.mu.iter().map(|&mu| InterfaceLaw::coulomb(mu)).collect();
-    let bond0 = vec![BondState::default(); n];
+    let history0 = vec![PointHistory::default(); n];
     let mut r = vec![[0.0; 3]; n];
     let mut x = vec![[0.0; 3]; n];
     let (mut residual, mut error) = error_of(&p.w, &p.q, &p.mu, &r, &mut x);
     let mut sweeps = 0;
     while error > tol && sweeps < max_iter {
-        let sol = gauss_seidel(&points, &laws, &bond0, 1.0, del, &p.q, &r, &r, 0.0, 1);
+        let sol = gauss_seidel(&points, &laws, &history0, 1.0, del, &p.q, &r, &r, 0.0, 1);
         r = sol.points.iter().map(|s| s.r_dry.into()).collect();
         sweeps += 1;
         (residual, error) = error_of(&p.w, &p.q, &p.mu, &r, &mut x);

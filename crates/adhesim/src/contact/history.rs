@@ -9,6 +9,13 @@
 //! stepper stores a [`NodeHistory`] per slave node; the law turns it back into its typed
 //! history at the start of a step and writes the committed one at its end
 //! ([`super::law::Interface`]).
+//!
+//! Within a step a contact point carries its law's history frozen at the start of the step,
+//! in the point's local frame, as a [`PointHistory`]: plain numbers again, which the law
+//! writes ([`super::law::Interface::point_history`]) and reads (its adhesive evaluation and
+//! its commit) through its own typed view ([`LawPointHistory`], e.g. RCC's
+//! [`super::law::BondState`]). The point solvers, the stepper and the fclib bridge only pass
+//! it along; a point's solution carries the history the step leads to in the same form.
 
 /// Largest number of values a node's history holds ([`NodeHistory`]): a scalar field takes
 /// one, a vector field three.
@@ -104,6 +111,33 @@ impl NodeHistory {
             .find(|(f, _)| f.name == name && f.kind == FieldKind::Scalar)
             .map(|(_, v)| v[0])
     }
+}
+
+/// The history of one contact point within a step as plain numbers, in the point's local
+/// frame (t₁, t₂, n), in an order of its law's choosing, zero-padded to
+/// [`MAX_HISTORY_VALUES`]: the frozen history at the start of the step, or the one the step
+/// leads to (in a point's solution). Only the law reads its values
+/// ([`LawPointHistory::decode`]).
+///
+/// The same convention as [`NodeHistory`]: the first value is the law's bond intensity, the
+/// point is bonded when it is positive, and a law without bonds keeps it 0.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PointHistory(pub [f64; MAX_HISTORY_VALUES]);
+
+impl PointHistory {
+    /// Whether the point is bonded (its first value is positive).
+    pub fn bonded(&self) -> bool {
+        self.0[0] > 0.0
+    }
+}
+
+/// A law's typed history at a contact point, in the point's local frame.
+pub trait LawPointHistory: Copy + Default + PartialEq + std::fmt::Debug {
+    /// Its values, the bond intensity first (or 0).
+    fn encode(&self) -> PointHistory;
+
+    /// The history whose [`LawPointHistory::encode`] is `h`.
+    fn decode(h: &PointHistory) -> Self;
 }
 
 /// A law's typed history at a slave node.

@@ -32,7 +32,7 @@
 
 pub use super::anisotropic::Orthotropy;
 use super::anisotropic::{scale, scale_matrix, unscale, unscale_matrix};
-use super::history::{HistoryField, LawHistory, NodeHistory};
+use super::history::{HistoryField, LawHistory, LawPointHistory, NodeHistory, PointHistory};
 use crate::{Mat3, Vec2, Vec3};
 use std::f64::consts::PI;
 
@@ -149,8 +149,13 @@ impl InterfaceLaw {
 /// What the stepper and the contact solves need from an interface law besides its friction
 /// cone (μ, [`InterfaceLaw::tangent_scale`]): its history at a slave node ([`LawHistory`],
 /// named fields for the outputs and the checkpoints), the frozen history the point solvers
-/// take at the start of a step, the adhesive response at that history, the history to commit
+/// take at the start of a step ([`PointHistory`], in the point's local frame), the adhesive
+/// response at that history with the point history it leads to, the node history to commit
 /// from a point's solution, and the force scale of its bonds.
+///
+/// A point history is plain numbers that only the law reads (through its typed view, e.g.
+/// [`BondState`] for RCC); the solvers pass it from [`Interface::point_history`] to the
+/// adhesive evaluations and from those, in the point's solution, to [`Interface::commit`].
 ///
 /// Every point solver reaches the adhesive part only through this trait, statically: the
 /// Gauss-Seidel point solver ([`solve_point`], implicit in x) through
@@ -179,16 +184,16 @@ pub trait Interface {
 
     /// The adhesive law at the local relative displacement `x` [m] (unscaled axes) of a point
     /// whose history is frozen at `start`, over a step of `dt` [s], with tributary area `area`
-    /// [m²]: the force r̃, its tangent −∂r̃/∂x, the incremental potential and the history
-    /// values the step leads to. Only called when [`Interface::is_adhesive`]; the
+    /// [m²]: the force r̃, its tangent −∂r̃/∂x, the incremental potential and the point
+    /// history the step leads to. Only called when [`Interface::is_adhesive`]; the
     /// Gauss-Seidel point solver ([`solve_point`]) solves with it.
-    fn adhesion_at(&self, start: &BondState, dt: f64, area: f64, x: Vec3) -> AdhEval;
+    fn adhesion_at(&self, start: &PointHistory, dt: f64, area: f64, x: Vec3) -> AdhEval;
 
     /// Warm start of the point solver's adhesive sub-problem at a point whose history is frozen
     /// at `start`, with tributary area `area` [m²]: the linear springs that approximate its
     /// bond, or None when it has none to start from. Only called when
     /// [`Interface::is_adhesive`].
-    fn frozen_springs(&self, start: &BondState, area: f64) -> Option<FrozenSprings>;
+    fn frozen_springs(&self, start: &PointHistory, area: f64) -> Option<FrozenSprings>;
 
     /// Warnings of the law about a contact pair's parameters (e.g. an adhesive stiffness the
     /// mesh cannot resolve), appended to `out`; none by default.
@@ -196,12 +201,12 @@ pub trait Interface {
 
     /// The adhesive response at the local relative displacement `x` [m] of a point whose
     /// history is frozen at `start`, over a step of `dt` [s], with tributary area `area` [m²]
-    /// (the force r̃, its secant stiffness, the incremental potential and the history it
-    /// leads to); None for a law without adhesion. The fclib Newton and the mixed solve
+    /// (the force r̃, its secant stiffness, the incremental potential and the point history
+    /// it leads to); None for a law without adhesion. The fclib Newton and the mixed solve
     /// linearise the law with it.
     fn adhesive_response(
         &self,
-        start: &BondState,
+        start: &PointHistory,
         dt: f64,
         area: f64,
         x: Vec3,
@@ -209,11 +214,17 @@ pub trait Interface {
 
     /// The frozen history at the start of a step of a point whose node history is `node`,
     /// in the point's local frame `frame` (rows t₁, t₂, n in global components).
-    fn point_history(&self, node: &NodeHistory, frame: &[[f64; 3]; 3]) -> BondState;
+    fn point_history(&self, node: &NodeHistory, frame: &[[f64; 3]; 3]) -> PointHistory;
 
     /// The node history to commit for a point that started the step with `start` and whose
-    /// solution is `sol`, in the local frame `frame`.
-    fn commit(&self, start: &BondState, sol: &PointSolution, frame: &[[f64; 3]; 3]) -> NodeHistory;
+    /// solution is `sol` (with the point history the step led to, [`PointSolution::history`]),
+    /// in the local frame `frame`.
+    fn commit(
+        &self,
+        start: &PointHistory,
+        sol: &PointSolution,
+        frame: &[[f64; 3]; 3],
+    ) -> NodeHistory;
 
     /// The history of a node that is no longer a contact candidate, from its last one.
     fn release(&self, node: &NodeHistory) -> NodeHistory;
@@ -268,7 +279,7 @@ pub fn natural_map_defect(law: &InterfaceLaw, rho: f64, r_dry: Vec3, x: Vec3) ->
 }
 
 /// Which case of the bi-potential projection the dry part fell into. Whether the point is
-/// bonded is reported separately (β > 0).
+/// bonded is reported separately ([`PointSolution::bonded`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ContactState {
     /// Separating: r̄ = 0 (the gap is open).
@@ -279,15 +290,44 @@ pub enum ContactState {
     Slide,
 }
 
-/// The committed interface state of a slave node at the start of a step.
+/// The RCC law's history at a contact point, in the point's local frame: its typed view of a
+/// [`PointHistory`], frozen at the start of a step or led to by it. The RCC functions of
+/// this module take and give it; the law's [`Interface`] implementation (`rcc.rs`) encodes
+/// it at the trait's boundary.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct BondState {
-    /// Intensity of adhesion β₀ ∈ [0, 1] [-].
+    /// Intensity of adhesion β ∈ [0, 1] [-].
     pub beta: f64,
     /// Accumulated stretch of the adhesive links in the (t1, t2) plane [m].
     pub ut: Vec2,
     /// Adhesive energy dissipated at the point so far, D [J/m²] ([`accumulated_damage`]).
     pub damage: f64,
+}
+
+impl LawPointHistory for BondState {
+    /// (β, u_t1, u_t2, D).
+    fn encode(&self) -> PointHistory {
+        let mut h = PointHistory::default();
+        h.0[0] = self.beta;
+        h.0[1] = self.ut[0];
+        h.0[2] = self.ut[1];
+        h.0[3] = self.damage;
+        h
+    }
+
+    fn decode(h: &PointHistory) -> Self {
+        BondState {
+            beta: h.0[0],
+            ut: Vec2::new(h.0[1], h.0[2]),
+            damage: h.0[3],
+        }
+    }
+}
+
+impl From<&PointHistory> for BondState {
+    fn from(h: &PointHistory) -> Self {
+        BondState::decode(h)
+    }
 }
 
 /// The adhesive energy dissipated at a point, D [J/m²], after a step in which β went from
@@ -424,8 +464,8 @@ pub struct PointProblem<'a> {
     pub x_free: Vec3,
     /// Interface law of the pair.
     pub law: &'a InterfaceLaw,
-    /// Committed interface state at the start of the step.
-    pub bond0: BondState,
+    /// The law's history of the point frozen at the start of the step.
+    pub history0: PointHistory,
     /// Time step Δt [s].
     pub dt: f64,
     /// Tributary area A [m²].
@@ -443,12 +483,11 @@ pub struct PointSolution {
     pub r_adh: Vec3,
     /// Local relative displacement x = x_free + W_αα (r̄ + r̃) [m].
     pub x: Vec3,
-    /// Intensity of adhesion β₁ at the end of the step [-].
-    pub beta: f64,
-    /// Bond stretch to commit [m]: u_t0 + x_t while bonded (β₁ > 0), else 0.
-    pub ut: Vec2,
+    /// The law's history of the point at the end of the step, as its adhesive evaluation
+    /// wrote it (zero for a law without adhesion): what [`Interface::commit`] reads.
+    pub history: PointHistory,
     /// Case of the solution: apart (r̄ = 0, x_n ≥ 0), stick (x = 0) or slide (r̄ on the cone,
-    /// opposing the slip, x_n = 0). Whether the point is bonded is `beta > 0`.
+    /// opposing the slip, x_n = 0). Whether the point is bonded is [`PointSolution::bonded`].
     pub state: ContactState,
     /// Iterations spent, counted as in [`solve_point`].
     pub iterations: usize,
@@ -462,9 +501,10 @@ impl PointSolution {
         self.r_dry + self.r_adh
     }
 
-    /// Whether an adhesive bond is present (β > 0).
+    /// Whether an adhesive bond is present at the end of the step (the bond intensity of
+    /// [`PointSolution::history`] is positive).
     pub fn bonded(&self) -> bool {
-        self.beta > 0.0
+        self.history.bonded()
     }
 }
 
@@ -523,10 +563,9 @@ struct Eval {
 /// An adhesive law evaluated at one x ([`Interface::adhesion_at`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct AdhEval {
-    /// β₁ [-].
-    pub beta: f64,
-    /// Bond stretch u_t0 + x_t [m].
-    pub ut: Vec2,
+    /// The point history the step leads to at this x (for RCC: β₁, the bond stretch
+    /// u_t0 + x_t while bonded, else 0, and D).
+    pub history: PointHistory,
     /// Adhesive force r̃ [N].
     pub force: Vec3,
     /// −∂r̃/∂x [N/m] (symmetric).
@@ -664,17 +703,11 @@ fn is_solution(ctx: &Ctx, ev: &Eval) -> bool {
 
 /// Packs an evaluation into a [`PointSolution`].
 fn finish(ev: &Eval, state: ContactState, iterations: usize, converged: bool) -> PointSolution {
-    let ut = if ev.adh.beta > 0.0 {
-        ev.adh.ut
-    } else {
-        Vec2::zeros()
-    };
     PointSolution {
         r_dry: ev.r_dry,
         r_adh: ev.r_adh,
         x: ev.x,
-        beta: ev.adh.beta,
-        ut,
+        history: ev.adh.history,
         state,
         iterations,
         converged,
@@ -982,10 +1015,10 @@ fn beta_step(beta0: f64, dt: f64, p: &RccParams, e: f64) -> (f64, f64) {
 fn adhesion_eval(ctx: &Ctx, x: Vec3) -> AdhEval {
     let (p, s) = (ctx.p, ctx.t2);
     if s == 1.0 {
-        return p.law.adhesion_at(&p.bond0, p.dt, p.area, x);
+        return p.law.adhesion_at(&p.history0, p.dt, p.area, x);
     }
     // x is scaled (x' = T x): the law at T⁻¹x', its force as T⁻¹r̃ and stiffness T⁻¹KT⁻¹.
-    let mut ev = p.law.adhesion_at(&p.bond0, p.dt, p.area, unscale(x, s));
+    let mut ev = p.law.adhesion_at(&p.history0, p.dt, p.area, unscale(x, s));
     ev.force = unscale(ev.force, s);
     ev.stiff = unscale_matrix(ev.stiff, s);
     ev
@@ -1000,6 +1033,14 @@ pub(super) fn rcc_adhesion_at(
     a: &RccParams,
     x: Vec3,
 ) -> AdhEval {
+    rcc_step(bond0, dt, area, a, x).1
+}
+
+/// The RCC law `a` at `x` from the committed bond state `bond0`, Δt [s] and tributary area
+/// [m²]: the bond state the step leads to (β₁; the stretch u_t0 + x_t while bonded, else 0;
+/// D after β₀ → β₁, [`accumulated_damage`]) and the evaluation, whose history is that state.
+fn rcc_step(bond0: BondState, dt: f64, area: f64, a: &RccParams, x: Vec3) -> (BondState, AdhEval) {
+    let undegraded = a;
     let a = &a.degraded(bond0.damage);
     let ut = bond0.ut + x.xy();
     let e = stretch_energy(a, x[2], ut);
@@ -1024,24 +1065,28 @@ pub(super) fn rcc_adhesion_at(
     } else {
         Mat3::zeros()
     };
-    AdhEval {
+    let end = BondState {
         beta,
-        ut,
+        ut: if beta > 0.0 { ut } else { Vec2::zeros() },
+        damage: accumulated_damage(bond0.damage, bond0.beta, beta, undegraded),
+    };
+    let ev = AdhEval {
+        history: end.encode(),
         force,
         stiff,
         energy,
-    }
+    };
+    (end, ev)
 }
 
-/// The RCC adhesive response at a local relative displacement x [m] (docs/model.md §5), for a
-/// point whose committed bond state is `bond0`, over a step of `dt` [s], with tributary area
-/// `area` [m²].
+/// The adhesive response of a law at a local relative displacement x [m] (docs/model.md §5),
+/// for a point whose history is frozen at the start of a step, over a step of `dt` [s], with
+/// tributary area `area` [m²] ([`Interface::adhesive_response`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AdhesiveResponse {
-    /// β₁ at the end of the step [-].
-    pub beta: f64,
-    /// Bond stretch to commit [m]: u_t0 + x_t while bonded (β₁ > 0), else 0.
-    pub ut: Vec2,
+    /// The point history the step leads to at this x (for RCC: β₁, the bond stretch to
+    /// commit, u_t0 + x_t while bonded and else 0, and D).
+    pub history: PointHistory,
     /// Adhesive force r̃ [N] in the local frame.
     pub force: Vec3,
     /// −∂r̃/∂x with β₁ held fixed [N/m]: A β₁² diag(C_t, C_t, C_n [x_n > 0]), symmetric
@@ -1051,7 +1096,8 @@ pub struct AdhesiveResponse {
     pub energy: f64,
 }
 
-/// [`AdhesiveResponse`] of the law `a` at `x` [m].
+/// [`AdhesiveResponse`] of the RCC law `a` at `x` [m], for a point whose committed bond state
+/// is `bond0`.
 pub fn adhesive_response(
     a: &RccParams,
     bond0: BondState,
@@ -1059,17 +1105,16 @@ pub fn adhesive_response(
     area: f64,
     x: Vec3,
 ) -> AdhesiveResponse {
-    let ev = rcc_adhesion_at(bond0, dt, area, a, x);
-    let k = area * ev.beta * ev.beta;
-    let secant_stiffness = if ev.beta > 0.0 {
+    let (end, ev) = rcc_step(bond0, dt, area, a, x);
+    let k = area * end.beta * end.beta;
+    let secant_stiffness = if end.beta > 0.0 {
         let kn = if x[2] > 0.0 { k * a.cn } else { 0.0 };
         Mat3::from_diagonal(&Vec3::new(k * a.ct, k * a.ct2, kn))
     } else {
         Mat3::zeros()
     };
     AdhesiveResponse {
-        beta: ev.beta,
-        ut: if ev.beta > 0.0 { ev.ut } else { Vec2::zeros() },
+        history: ev.history,
         force: ev.force,
         secant_stiffness,
         energy: ev.energy,
@@ -1086,7 +1131,7 @@ fn frozen_adhesion_guess(ctx: &Ctx, y: Vec3) -> Vec3 {
     let Some(FrozenSprings {
         stiffness: c,
         stretch: e,
-    }) = p.law.frozen_springs(&p.bond0, p.area)
+    }) = p.law.frozen_springs(&p.history0, p.area)
     else {
         return Vec3::zeros();
     };
@@ -1367,6 +1412,11 @@ mod tests {
 
     use crate::mat3_from_rows;
 
+    /// The RCC history a point's solution leads to.
+    fn end(s: &PointSolution) -> BondState {
+        BondState::decode(&s.history)
+    }
+
     /// A local vector from its components.
     fn v3(a: f64, b: f64, c: f64) -> Vec3 {
         Vec3::new(a, b, c)
@@ -1445,7 +1495,7 @@ mod tests {
             w_aa: w,
             x_free,
             law,
-            bond0,
+            history0: bond0.encode(),
             dt: 1e-4,
             area: 1e-6,
             rho: default_rho(w),
@@ -1493,9 +1543,10 @@ mod tests {
         match &p.law.adhesion {
             None => assert_eq!(s.r_adh, Vec3::zeros()),
             Some(a) => {
-                let ut = Vec2::new(p.bond0.ut[0] + x[0], p.bond0.ut[1] + x[1]);
-                let beta = beta_update(p.bond0.beta, p.dt, a, x[2], ut);
-                assert!((beta - s.beta).abs() <= 1e-9, "β {beta} vs {}", s.beta);
+                let (b0, b1) = (BondState::decode(&p.history0), end(s));
+                let ut = Vec2::new(b0.ut[0] + x[0], b0.ut[1] + x[1]);
+                let beta = beta_update(b0.beta, p.dt, a, x[2], ut);
+                assert!((beta - b1.beta).abs() <= 1e-9, "β {beta} vs {}", b1.beta);
                 let ra = adhesive_force(beta, a, x[2], ut, p.area);
                 let scale = ra.norm() + p.area * a.peak_traction();
                 assert!(
@@ -1888,8 +1939,8 @@ mod tests {
             assert!((-s.r()[2] - expect).abs() <= 1e-5 * scale, "step {k}");
             peak = peak.max(-s.r()[2]);
             bond = BondState {
-                beta: s.beta,
-                ut: s.ut,
+                beta: end(&s).beta,
+                ut: end(&s).ut,
                 damage: 0.0,
             };
         }
@@ -2027,7 +2078,7 @@ mod tests {
             let k = 2e9 * 1e-6;
             let xn = 1e-5 / (1.0 + k * wnn);
             assert_eq!(s.state, ContactState::Apart);
-            assert_eq!(s.beta, 1.0);
+            assert_eq!(end(&s).beta, 1.0);
             assert!(rel(s.x[2], xn) < 1e-10, "x_n {} vs {xn}", s.x[2]);
             assert!(rel(s.r()[2], -k * xn) < 1e-10);
             assert!(s.iterations <= 3, "{} iterations", s.iterations);
@@ -2052,8 +2103,8 @@ mod tests {
         let p = problem(&law, w, v3(2e-3, 0.0, -1e-3), bond);
         let s = solve_point(&p, Vec3::zeros(), 1e-12, 100);
         assert!(s.converged);
-        assert!(s.beta > 0.0);
-        assert_eq!(s.ut, Vec2::new(1e-6 + s.x[0], s.x[1]));
+        assert!(end(&s).beta > 0.0);
+        assert_eq!(end(&s).ut, Vec2::new(1e-6 + s.x[0], s.x[1]));
         check_solution(&p, &s, 1e-9);
         // Far apart with a weak bond: broken, stretch reset.
         let bond = BondState {
@@ -2065,8 +2116,8 @@ mod tests {
         p.dt = 1.0;
         let s = solve_point(&p, Vec3::zeros(), 1e-12, 100);
         assert!(s.converged);
-        assert_eq!(s.beta, 0.0);
-        assert_eq!(s.ut, Vec2::zeros());
+        assert_eq!(end(&s).beta, 0.0);
+        assert_eq!(end(&s).ut, Vec2::zeros());
         assert_eq!(s.r(), Vec3::zeros());
     }
 
@@ -2114,7 +2165,7 @@ mod tests {
                 w_aa: w,
                 x_free,
                 law: &law,
-                bond0: bond,
+                history0: bond.encode(),
                 dt: 1e-4,
                 area,
                 rho: default_rho(w),
@@ -2289,12 +2340,12 @@ mod tests {
                     rel(xn, af * xc / 101.0) < 1e-9,
                     "bonded branch at a = {af} x_c"
                 );
-                assert_eq!(s.beta, 1.0);
+                assert_eq!(end(&s).beta, 1.0);
             }
             prev_xn = xn;
             bond = BondState {
-                beta: s.beta,
-                ut: s.ut,
+                beta: end(&s).beta,
+                ut: end(&s).ut,
                 damage: 0.0,
             };
             r = s.r_dry;
@@ -2336,7 +2387,7 @@ mod tests {
                 w_aa: w,
                 x_free: xf,
                 law: &law,
-                bond0: bond,
+                history0: bond.encode(),
                 dt,
                 area,
                 rho: default_rho(w),
@@ -2350,7 +2401,7 @@ mod tests {
             w_aa: Mat3::zeros(),
             x_free: v3(0.0, 0.0, 1e-3),
             law: &DRY,
-            bond0: BondState::default(),
+            history0: PointHistory::default(),
             dt: 1e-4,
             area: 1e-6,
             rho: 1.0,

@@ -30,14 +30,15 @@
 use faer::sparse::{Pair, SymbolicSparseColMat};
 
 use super::anisotropic::{scale, unscale};
+use super::history::PointHistory;
 use super::law::{
     bipotential_trial, dry_projection, modified_displacement_jacobian, projection_jacobian,
-    BondState, Interface, InterfaceLaw, PointSolution,
+    Interface, InterfaceLaw, PointSolution,
 };
 use super::semismooth::{ARMIJO, ETA_DOWN, ETA_MAX, ETA_MIN, ETA_START, ETA_UP};
 use crate::linalg::{metis_dof_ordering, BlockPattern};
 use crate::sparse_lu::OrderedLu;
-use crate::{Mat3, Vec2, Vec3};
+use crate::{Mat3, Vec3};
 
 type V3 = [f64; 3];
 
@@ -60,18 +61,18 @@ pub struct PointLinearisation {
     /// B without the change of x̂'s normal component with the slip (D = I): what makes B
     /// unsymmetric for a sliding point [N/m].
     pub b_plain: Mat3,
-    /// The point's forces, β₁, bond stretch and case at (r, x).
+    /// The point's forces, the history the step leads to and case at (r, x).
     pub solution: PointSolution,
 }
 
 /// [`PointLinearisation`] of the law `law` at total force `r` [N] and local relative
-/// displacement `x` [m], for a point with committed bond `bond0`, step `dt` [s], tributary
-/// area `area` [m²] and natural-map parameter `rho` [N/m]. An orthotropic law is linearised in
-/// its scaled variables (y' = T⁻¹y, x' = Tx) and mapped back: Φ = TΦ', A = T A' T⁻¹,
-/// B_dry = T B' T.
+/// displacement `x` [m], for a point whose law's history is frozen at `history0`, step `dt`
+/// [s], tributary area `area` [m²] and natural-map parameter `rho` [N/m]. An orthotropic law
+/// is linearised in its scaled variables (y' = T⁻¹y, x' = Tx) and mapped back: Φ = TΦ',
+/// A = T A' T⁻¹, B_dry = T B' T.
 pub fn linearise_point(
     law: &InterfaceLaw,
-    bond0: BondState,
+    history0: PointHistory,
     dt: f64,
     area: f64,
     rho: f64,
@@ -80,9 +81,9 @@ pub fn linearise_point(
 ) -> PointLinearisation {
     let mu = law.mu.max(0.0);
     let (r, x) = (Vec3::from(r), Vec3::from(x));
-    let (r_adh, k_adh, beta, ut) = match law.adhesive_response(&bond0, dt, area, x) {
-        Some(resp) => (resp.force, resp.secant_stiffness, resp.beta, resp.ut),
-        None => (Vec3::zeros(), Mat3::zeros(), 0.0, Vec2::zeros()),
+    let (r_adh, k_adh, history) = match law.adhesive_response(&history0, dt, area, x) {
+        Some(resp) => (resp.force, resp.secant_stiffness, resp.history),
+        None => (Vec3::zeros(), Mat3::zeros(), PointHistory::default()),
     };
     let y = r - r_adh;
     let s = law.tangent_scale();
@@ -106,8 +107,7 @@ pub fn linearise_point(
             r_dry: y,
             r_adh,
             x,
-            beta,
-            ut,
+            history,
             state,
             iterations: 1,
             converged: true,
@@ -512,11 +512,13 @@ pub fn solve_mixed(
 #[cfg(test)]
 mod tests {
     use super::super::anisotropic::Orthotropy;
-    use super::super::law::RccParams;
+    use super::super::history::LawPointHistory;
+    use super::super::law::{BondState, RccParams};
     use super::super::reduced::test_support::{random_spd, Lcg};
     use super::super::reduced::BlockSparseDelassus;
     use super::super::semismooth::semismooth_newton;
     use super::*;
+    use crate::Vec2;
 
     /// Central differences of Φ with respect to r (columns of A) and x (columns of B).
     fn fd_jacobians(f: impl Fn(V3, V3) -> V3, r: V3, x: V3, hr: f64, hx: f64) -> (Mat3, Mat3) {
@@ -550,7 +552,8 @@ mod tests {
             beta: 1.0,
             ut: Vec2::zeros(),
             damage: 0.0,
-        };
+        }
+        .encode();
         let laws = [
             InterfaceLaw::coulomb(0.3),
             InterfaceLaw {
@@ -665,7 +668,8 @@ mod tests {
                 beta: 0.0,
                 ut: Vec2::zeros(),
                 damage: 0.0,
-            };
+            }
+            .encode();
             let lin = |p: usize, r: V3, x: V3| linearise_point(&law, bond, 1.0, 1.0, rho[p], r, x);
             let force: f64 = reference
                 .r

@@ -21,6 +21,6 @@ pub mod semismooth;
 pub mod solve;
 
 pub use detect::{ContactPair, Master, RigidMotion, RigidShape};
-pub use history::{HistoryField, LawHistory, NodeHistory};
+pub use history::{HistoryField, LawHistory, LawPointHistory, NodeHistory, PointHistory};
 pub use law::{BondState, ContactState, Interface, InterfaceLaw, RccParams};
 pub use rcc::RccHistory;

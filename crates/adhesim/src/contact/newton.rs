@@ -20,12 +20,12 @@
 
 use super::anisotropic::{scale, scale_matrix, unscale};
 use super::detect::ContactPoint;
+use super::history::PointHistory;
 use super::law::{
-    bipotential_trial, dry_projection, BondState, ContactState, Interface, InterfaceLaw,
-    PointSolution,
+    bipotential_trial, dry_projection, ContactState, Interface, InterfaceLaw, PointSolution,
 };
 use crate::system::SystemMatrix;
-use crate::{Mat3, Vec2, Vec3};
+use crate::{Mat3, Vec3};
 
 /// ρ_α as a multiple of the stiffness K̄ shows at contact point α: each multiplier update
 /// contracts the error by about 1/(1 + this) at an isolated point.
@@ -34,7 +34,7 @@ pub const RHO_FACTOR: f64 = 1000.0;
 /// The contact law linearised at one point for one Newton iteration.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AugmentedPoint {
-    /// The point's forces, β₁, bond stretch and case at the current displacement.
+    /// The point's forces, the history the step leads to and case at the current displacement.
     pub solution: PointSolution,
     /// −∂r/∂x used in the Newton matrix [N/m], symmetric positive semi-definite.
     pub stiffness: Mat3,
@@ -121,10 +121,11 @@ pub struct DryForce {
     pub energy: f64,
 }
 
-/// The contact law at one point: dry force through the projection of λ − ρ x̂, RCC adhesive
-/// force at x, and their stiffness for the Newton matrix.
+/// The contact law at one point: dry force through the projection of λ − ρ x̂, the law's
+/// adhesive force at x, and their stiffness for the Newton matrix.
 ///
-/// `bond0` is the committed bond state, `dt` [s] the step, `area` [m²] the tributary area,
+/// `history0` is the law's history of the point frozen at the start of the step, `dt` [s] the
+/// step, `area` [m²] the tributary area,
 /// `rho` [N/m] the augmentation parameter, `lambda` [N] the multiplier and `x` [m] the local
 /// relative displacement (slip increment t₁, t₂; end gap n).
 ///
@@ -132,7 +133,7 @@ pub struct DryForce {
 /// softening of β₁): they change the convergence rate, not the solution.
 pub fn augmented_point(
     law: &InterfaceLaw,
-    bond0: BondState,
+    history0: PointHistory,
     dt: f64,
     area: f64,
     rho: f64,
@@ -153,20 +154,19 @@ pub fn augmented_point(
         }
     };
     let (r_dry, state, mut stiffness) = (dry.force, dry.state, dry.stiffness);
-    let (beta, ut, r_adh, adhesive_energy) = match law.adhesive_response(&bond0, dt, area, x) {
+    let (history, r_adh, adhesive_energy) = match law.adhesive_response(&history0, dt, area, x) {
         Some(resp) => {
             stiffness += resp.secant_stiffness;
-            (resp.beta, resp.ut, resp.force, resp.energy)
+            (resp.history, resp.force, resp.energy)
         }
-        None => (0.0, Vec2::zeros(), Vec3::zeros(), 0.0),
+        None => (PointHistory::default(), Vec3::zeros(), 0.0),
     };
     AugmentedPoint {
         solution: PointSolution {
             r_dry,
             r_adh,
             x,
-            beta,
-            ut,
+            history,
             state,
             iterations: 1,
             converged: true,
@@ -269,7 +269,9 @@ pub fn defect_norm(evals: &[AugmentedPoint]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::law::{adhesive_response, ContactState, RccParams};
+    use crate::contact::history::LawPointHistory;
+    use crate::contact::law::{adhesive_response, BondState, ContactState, RccParams};
+    use crate::Vec2;
 
     fn dry(mu: f64) -> InterfaceLaw {
         InterfaceLaw {
@@ -297,7 +299,7 @@ mod tests {
             let xn = (k * x_free + lambda[2]) / (k + rho);
             let ev = augmented_point(
                 &law,
-                BondState::default(),
+                PointHistory::default(),
                 1e-3,
                 1.0,
                 rho,
@@ -324,7 +326,7 @@ mod tests {
         let law = dry(0.5);
         let rho = 1e3;
         let at = |lambda: Vec3, x: Vec3| {
-            augmented_point(&law, BondState::default(), 1e-3, 1.0, rho, lambda, x)
+            augmented_point(&law, PointHistory::default(), 1e-3, 1.0, rho, lambda, x)
         };
         // Apart: positive gap, zero multiplier.
         let ev = at(Vec3::zeros(), Vec3::new(1e-3, 0.0, 2e-3));
@@ -360,7 +362,7 @@ mod tests {
             damage: 0.0,
         };
         let x = Vec3::new(1e-7, 0.0, 5e-8);
-        let ev = augmented_point(&law, bond0, 1e-4, 2e-6, 1e3, Vec3::zeros(), x);
+        let ev = augmented_point(&law, bond0.encode(), 1e-4, 2e-6, 1e3, Vec3::zeros(), x);
         let resp = adhesive_response(&a, bond0, 1e-4, 2e-6, x);
         assert_eq!(ev.solution.r_adh, resp.force);
         assert!(resp.force[2] < 0.0 && resp.force[0] < 0.0);

@@ -1,14 +1,18 @@
 //! The RCC interface law as the stepper and the outputs see it (docs/model.md §5): its history
 //! at a slave node (intensity of adhesion β, bond stretch u_t, dissipated adhesive energy D)
 //! with its named fields, and the [`Interface`] implementation that reads the history at the
-//! start of a step and writes it when the step is committed. Dry Coulomb friction is this law
+//! start of a step and writes it when the step is committed. At a contact point within a step
+//! the same three quantities, in the point's local frame, are its [`BondState`], encoded to
+//! the law-agnostic [`PointHistory`] the solvers carry. Dry Coulomb friction is this law
 //! without adhesion ([`InterfaceLaw::coulomb`]): β stays 0 and D keeps what it had.
 //!
 //! The same implementation gives the point solvers the law's adhesive force, its tangent and
 //! warm start (evaluated by [`super::law`]: β update, fatigue) and its checks of a pair's
 //! parameters (the adhesive stiffness against the mesh).
 
-use super::history::{FieldKind, HistoryField, LawHistory, NodeHistory, Slot};
+use super::history::{
+    FieldKind, HistoryField, LawHistory, LawPointHistory, NodeHistory, PointHistory, Slot,
+};
 use super::law::{
     accumulated_damage, adhesive_response, clamp01, rcc_adhesion_at, AdhEval, AdhesiveResponse,
     BondState, FrozenSprings, Interface, InterfaceLaw, PairScales, PointSolution,
@@ -88,9 +92,9 @@ impl Interface for InterfaceLaw {
         self.adhesion.is_some()
     }
 
-    fn adhesion_at(&self, start: &BondState, dt: f64, area: f64, x: Vec3) -> AdhEval {
+    fn adhesion_at(&self, start: &PointHistory, dt: f64, area: f64, x: Vec3) -> AdhEval {
         match &self.adhesion {
-            Some(a) => rcc_adhesion_at(*start, dt, area, a, x),
+            Some(a) => rcc_adhesion_at(BondState::decode(start), dt, area, a, x),
             None => AdhEval::default(),
         }
     }
@@ -121,8 +125,9 @@ impl Interface for InterfaceLaw {
     }
 
     /// Springs A β₀² (C_t, C_t2, C_n) at the undegraded stiffnesses, stretched by u_t0.
-    fn frozen_springs(&self, start: &BondState, area: f64) -> Option<FrozenSprings> {
+    fn frozen_springs(&self, start: &PointHistory, area: f64) -> Option<FrozenSprings> {
         let a = self.adhesion.as_ref()?;
+        let start = BondState::decode(start);
         let b0 = clamp01(start.beta);
         let k = area * b0 * b0;
         if k.is_nan() || k <= 0.0 {
@@ -136,17 +141,17 @@ impl Interface for InterfaceLaw {
 
     fn adhesive_response(
         &self,
-        start: &BondState,
+        start: &PointHistory,
         dt: f64,
         area: f64,
         x: Vec3,
     ) -> Option<AdhesiveResponse> {
         self.adhesion
             .as_ref()
-            .map(|a| adhesive_response(a, *start, dt, area, x))
+            .map(|a| adhesive_response(a, BondState::decode(start), dt, area, x))
     }
 
-    fn point_history(&self, node: &NodeHistory, frame: &[[f64; 3]; 3]) -> BondState {
+    fn point_history(&self, node: &NodeHistory, frame: &[[f64; 3]; 3]) -> PointHistory {
         let h = RccHistory::decode(node);
         let ut = Vec3::from(h.ut);
         BondState {
@@ -154,19 +159,29 @@ impl Interface for InterfaceLaw {
             ut: Vec2::new(ut.dot(&Vec3::from(frame[0])), ut.dot(&Vec3::from(frame[1]))),
             damage: h.damage,
         }
+        .encode()
     }
 
-    fn commit(&self, start: &BondState, sol: &PointSolution, frame: &[[f64; 3]; 3]) -> NodeHistory {
+    /// β₁ and u_t as the step left them, u_t turned to global axes; D as the adhesive
+    /// evaluation accumulated it (§5.4), or kept from the start without adhesion (the point's
+    /// solution then carries no history of its own).
+    fn commit(
+        &self,
+        start: &PointHistory,
+        sol: &PointSolution,
+        frame: &[[f64; 3]; 3],
+    ) -> NodeHistory {
+        let end = BondState::decode(&sol.history);
         let damage = match &self.adhesion {
-            Some(a) => accumulated_damage(start.damage, start.beta, sol.beta, a),
-            None => start.damage,
+            Some(_) => end.damage,
+            None => BondState::decode(start).damage,
         };
         // The same sums as a frame's rotation of (u_t1, u_t2, 0), to the bit.
         let ut = std::array::from_fn(|k| {
-            sol.ut[0] * frame[0][k] + sol.ut[1] * frame[1][k] + 0.0 * frame[2][k]
+            end.ut[0] * frame[0][k] + end.ut[1] * frame[1][k] + 0.0 * frame[2][k]
         });
         RccHistory {
-            beta: sol.beta,
+            beta: end.beta,
             ut,
             damage,
         }
@@ -184,5 +199,92 @@ impl Interface for InterfaceLaw {
             ..Default::default()
         }
         .encode()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::law::{ContactState, RccParams};
+
+    /// RCC's point history survives its encoding exactly (bit for bit, NaN and −0 included),
+    /// and the law-agnostic `bonded` of the encoding is β > 0.
+    #[test]
+    fn point_history_round_trips_the_bond_state_and_bonded_is_beta_positive() {
+        let betas = [
+            0.0,
+            -0.0,
+            1.0,
+            0.5,
+            1e-300,
+            -1e-3,
+            f64::MIN_POSITIVE,
+            f64::NAN,
+            f64::INFINITY,
+        ];
+        for (i, &beta) in betas.iter().enumerate() {
+            let typed = BondState {
+                beta,
+                ut: Vec2::new(1e-6 * i as f64, -3e-7 / (1.0 + i as f64)),
+                damage: [0.0, 12.5, f64::NAN][i % 3],
+            };
+            let h = typed.encode();
+            let back = BondState::decode(&h);
+            let bits = |b: &BondState| [b.beta, b.ut[0], b.ut[1], b.damage].map(f64::to_bits);
+            assert_eq!(bits(&back), bits(&typed), "β = {beta}");
+            assert_eq!(h.bonded(), beta > 0.0, "β = {beta}");
+            // The values past RCC's four stay zero.
+            assert!(h.0[4..].iter().all(|v| v.to_bits() == 0));
+            let sol = PointSolution {
+                r_dry: Vec3::zeros(),
+                r_adh: Vec3::zeros(),
+                x: Vec3::zeros(),
+                history: h,
+                state: ContactState::Apart,
+                iterations: 1,
+                converged: true,
+            };
+            assert_eq!(sol.bonded(), beta > 0.0, "β = {beta}");
+        }
+    }
+
+    /// A node's history taken to a point's local frame and committed back unchanged (the
+    /// point's solution carrying its start history: β kept, so no energy dissipated) is the
+    /// node's history again: β and D exactly, u_t (in the tangent plane) to round-off of
+    /// the two rotations, 1e-15 of its length.
+    #[test]
+    fn node_history_through_the_point_frame_and_back() {
+        let law = InterfaceLaw {
+            mu: 0.3,
+            adhesion: Some(RccParams::new(20.0, 2e9, 2e9, 0.1)),
+            anisotropy: None,
+        };
+        let (c, s) = (0.6_f64, 0.8_f64);
+        // Rows t₁, t₂, n: orthonormal, n = t₁ × t₂.
+        let frame = [[c, s, 0.0], [0.0, 0.0, 1.0], [s, -c, 0.0]];
+        let ut = Vec3::from(frame[0]) * 2e-6 - Vec3::from(frame[1]) * 5e-7;
+        let node = RccHistory {
+            beta: 0.75,
+            ut: ut.into(),
+            damage: 3.5,
+        }
+        .encode();
+        let start = law.point_history(&node, &frame);
+        let local = BondState::decode(&start);
+        assert_eq!((local.beta, local.damage), (0.75, 3.5));
+        assert!(start.bonded() && node.bonded());
+        let sol = PointSolution {
+            r_dry: Vec3::zeros(),
+            r_adh: Vec3::zeros(),
+            x: Vec3::zeros(),
+            history: start,
+            state: ContactState::Stick,
+            iterations: 1,
+            converged: true,
+        };
+        let back = RccHistory::decode(&law.commit(&start, &sol, &frame));
+        assert_eq!((back.beta, back.damage), (0.75, 3.5));
+        let err = (Vec3::from(back.ut) - ut).norm();
+        assert!(err <= 1e-15 * ut.norm(), "u_t {:?} vs {ut:?}", back.ut);
     }
 }

@@ -9,7 +9,8 @@
 //! semismooth Newton method is in [`super::semismooth`]. Both stop on Siconos's relative error
 //! ([`relative_error`] of [`natural_map_residual`]).
 
-use super::law::{default_rho, solve_point, BondState, InterfaceLaw, PointProblem};
+use super::history::PointHistory;
+use super::law::{default_rho, solve_point, InterfaceLaw, PointProblem};
 use super::natural_map::{natural_map_residual, relative_error};
 use crate::mat3_from_rows;
 
@@ -222,7 +223,7 @@ pub fn gauss_seidel_sweep(
             w_aa: mat3_from_rows(w.diagonal_block(p)),
             x_free: x_free.into(),
             law: &law,
-            bond0: BondState::default(),
+            history0: PointHistory::default(),
             dt: 1.0,
             area: 1.0,
             rho: rho[p],

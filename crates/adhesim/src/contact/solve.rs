@@ -3,7 +3,8 @@
 //! a nonlinear Gauss-Seidel sweep over contact points with the local bi-potential/RCC solve.
 
 use super::detect::ContactPoint;
-use super::law::{default_rho, solve_point, BondState, InterfaceLaw, PointProblem, PointSolution};
+use super::history::PointHistory;
+use super::law::{default_rho, solve_point, InterfaceLaw, PointProblem, PointSolution};
 use crate::linalg::LinearSolve;
 use crate::{mat3_from_rows, Mat3};
 
@@ -172,7 +173,8 @@ impl Delassus {
 
 /// Result of the Gauss-Seidel solve.
 pub struct ContactSolution {
-    /// Per point: the local solution (dry and adhesive forces, x, β, u_t, state).
+    /// Per point: the local solution (dry and adhesive forces, x, the law's history at the end
+    /// of the step, state).
     pub points: Vec<PointSolution>,
     /// Sweeps done.
     pub sweeps: usize,
@@ -186,7 +188,7 @@ pub struct ContactSolution {
 pub fn gauss_seidel(
     points: &[ContactPoint],
     laws: &[InterfaceLaw],
-    bond0: &[BondState],
+    history0: &[PointHistory],
     dt: f64,
     del: &Delassus,
     x_free: &[[f64; 3]],
@@ -230,7 +232,7 @@ pub fn gauss_seidel(
                 w_aa: blocks[p],
                 x_free: xf.into(),
                 law: &laws[points[p].pair],
-                bond0: bond0[p],
+                history0: history0[p],
                 dt,
                 area: points[p].area,
                 rho: rhos[p],

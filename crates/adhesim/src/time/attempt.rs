@@ -2,7 +2,8 @@
 //! its phases.
 
 use crate::contact::detect::ContactPoint;
-use crate::contact::law::{BondState, PointSolution};
+use crate::contact::history::PointHistory;
+use crate::contact::law::PointSolution;
 
 /// Wall time spent in each phase of a step [s].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -29,8 +30,8 @@ pub(super) struct Attempt {
     pub(super) internal: f64,
     pub(super) work: f64,
     pub(super) points: Vec<ContactPoint>,
-    /// Committed bond state of each candidate at the start of the step (local frames).
-    pub(super) bond0: Vec<BondState>,
+    /// The law's history of each candidate frozen at the start of the step (local frames).
+    pub(super) history0: Vec<PointHistory>,
     pub(super) solutions: Vec<PointSolution>,
     pub(super) sweeps: usize,
     pub(super) contact_residual: f64,

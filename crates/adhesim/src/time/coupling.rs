@@ -7,8 +7,9 @@
 use super::attempt::PhaseTimes;
 use super::constraints::Constraints;
 use crate::contact::detect::ContactPoint;
+use crate::contact::history::PointHistory;
 use crate::contact::law::natural_map_defect;
-use crate::contact::law::{BondState, PointSolution};
+use crate::contact::law::PointSolution;
 use crate::contact::newton;
 use crate::contact::InterfaceLaw;
 use crate::system::SystemMatrix;
@@ -19,8 +20,9 @@ pub struct StepContact<'a> {
     pub points: Vec<ContactPoint>,
     /// Interface law of each contact pair.
     pub laws: Vec<InterfaceLaw>,
-    /// Committed bond state of each candidate, in its local frame.
-    pub bond0: Vec<BondState>,
+    /// The law's history of each candidate frozen at the start of the step, in its local
+    /// frame.
+    pub history0: Vec<PointHistory>,
     /// Force the adhesive bonds of the candidates can carry, ‖(A_α √(C w))_α‖ [N]: the force
     /// scale of an interface that holds (or snaps into) contact without load.
     pub bond_strength: f64,
@@ -38,8 +40,8 @@ pub struct StepContact<'a> {
 pub struct Candidates {
     /// Candidates found at the start of the step.
     pub points: Vec<ContactPoint>,
-    /// Committed bond state of each, in its local frame.
-    pub bond0: Vec<BondState>,
+    /// The law's history of each frozen at the start of the step, in its local frame.
+    pub history0: Vec<PointHistory>,
     /// Force their bonds can carry [N] (see [`StepContact::bond_strength`]).
     pub bond_strength: f64,
     /// The solver of the step.
@@ -61,7 +63,7 @@ impl<'a> StepContact<'a> {
         let contact = StepContact {
             points: candidates.points,
             laws,
-            bond0: candidates.bond0,
+            history0: candidates.history0,
             bond_strength: candidates.bond_strength,
             rho: Vec::new(),
             dt,
@@ -73,11 +75,11 @@ impl<'a> StepContact<'a> {
 }
 
 impl StepContact<'_> {
-    /// The candidates and their bond state at the start of the step, handed back at its end.
-    pub fn take_candidates(&mut self) -> (Vec<ContactPoint>, Vec<BondState>) {
+    /// The candidates and their history at the start of the step, handed back at its end.
+    pub fn take_candidates(&mut self) -> (Vec<ContactPoint>, Vec<PointHistory>) {
         (
             std::mem::take(&mut self.points),
-            std::mem::take(&mut self.bond0),
+            std::mem::take(&mut self.history0),
         )
     }
 

@@ -189,7 +189,7 @@ impl<'a> ContactCoupling<'a> for DelassusCoupling<'a> {
         let sol = gauss_seidel(
             &sc.points,
             &sc.laws,
-            &sc.bond0,
+            &sc.history0,
             sc.dt,
             del,
             &x_free,

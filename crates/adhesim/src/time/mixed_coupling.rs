@@ -178,7 +178,7 @@ impl<'a> ContactCoupling<'a> for MixedCoupling<'a> {
         let law = |p: usize, r: [f64; 3], x: [f64; 3]| {
             let pt = &sc.points[p];
             let law = &sc.laws[pt.pair];
-            linearise_point(law, sc.bond0[p], sc.dt, pt.area, rho[p], r, x)
+            linearise_point(law, sc.history0[p], sc.dt, pt.area, rho[p], r, x)
         };
         let measure = |pts: &[PointSolution]| sc.natural_map(pts);
         // K̄ as the Newton loop set it, restored before each direction's factorisation.

@@ -83,7 +83,7 @@ impl<'a> NewtonCoupling<'a> {
                 let law = &sc.laws[pt.pair];
                 augmented_point(
                     law,
-                    sc.bond0[p],
+                    sc.history0[p],
                     sc.dt,
                     pt.area,
                     sc.rho[p],

@@ -170,7 +170,7 @@ impl<'a> NewtonLoop<'a> {
     /// Stage *commit* (what the step hands back): the converged iterate `u` with its end
     /// velocity, work, forces and contact solution.
     fn finish(&mut self, u: &[f64], asm: Assembled, check: Check) -> Attempt {
-        let (points, bond0) = self.coupling.step_contact().take_candidates();
+        let (points, history0) = self.coupling.step_contact().take_candidates();
         let force = self.coupling.contact_force();
         Attempt {
             work: self.step.work(u, &check.reactions, force),
@@ -188,7 +188,7 @@ impl<'a> NewtonLoop<'a> {
             timings: self.timings,
             reactions: check.reactions,
             points,
-            bond0,
+            history0,
         }
     }
 }
