@@ -14,6 +14,7 @@
 //!   starts (the local element size, not the mean over the surface).
 
 use crate::contact::law::{Interface, PairScales};
+pub use crate::contact::rcc::{cohesive_zone_length, CN_STIFFNESS_RATIO};
 use crate::contact::{Master, RigidShape};
 use crate::mesh::Mesh;
 use crate::problem::{Problem, Table};
@@ -26,18 +27,8 @@ pub const DT_WAVE_RATIO: f64 = 1000.0;
 /// the loading is then slow, and not resolving waves is intended.
 pub const SLOW_LOADING_MACH: f64 = 1e-3;
 
-/// Warn when C_n·A exceeds this many times E·h (per slave node).
-pub const CN_STIFFNESS_RATIO: f64 = 1e4;
-
 /// Warn when the estimated contact half-width holds fewer slave elements than this.
 pub const MIN_ELEMENTS_ACROSS_CONTACT: f64 = 3.0;
-
-/// Length of the adhesive cohesive zone E*/C_n [m]: the plane-strain modulus
-/// E* = E/(1 − ν²) [Pa] of the slave body over the adhesive normal stiffness C_n [N/m³].
-/// Over a length much shorter than this the body is stiffer than the adhesive layer.
-pub fn cohesive_zone_length(young: f64, poisson: f64, cn: f64) -> f64 {
-    young / (1.0 - poisson * poisson) / cn
-}
 
 /// The warnings for a validated problem, each stating the number that triggered it and the
 /// threshold. Empty when nothing looks suspicious.

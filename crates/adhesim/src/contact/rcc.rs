@@ -17,8 +17,17 @@ use super::law::{
     accumulated_damage, adhesive_response, clamp01, rcc_adhesion_at, AdhEval, AdhesiveResponse,
     BondState, FrozenSprings, Interface, InterfaceLaw, PairScales, PointSolution,
 };
-use crate::warnings::{cohesive_zone_length, CN_STIFFNESS_RATIO};
 use crate::{Vec2, Vec3};
+
+/// Warn when C_n·A exceeds this many times E·h (per slave node).
+pub const CN_STIFFNESS_RATIO: f64 = 1e4;
+
+/// Length of the adhesive cohesive zone E*/C_n [m]: the plane-strain modulus
+/// E* = E/(1 − ν²) [Pa] of the slave body over the adhesive normal stiffness C_n [N/m³].
+/// Over a length much shorter than this the body is stiffer than the adhesive layer.
+pub fn cohesive_zone_length(young: f64, poisson: f64, cn: f64) -> f64 {
+    young / (1.0 - poisson * poisson) / cn
+}
 
 /// The history of the RCC law at a slave node, between steps.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
