@@ -13,8 +13,9 @@ use crate::anp::{
     add_volume_hessian, has_volumetric_split, IsochoricPart, NodalPatches, PatchState,
 };
 use crate::element::{
-    element_cauchy_stress, element_response_with_history, gauss_point_c, DegenerateElement,
-    Element, ElementResponse, ElementType, GaussPoint, Stabilisation, Tet4, ELEMENT_TYPES,
+    element_cauchy_stress, element_response_with_history, gauss_point_c, visit_element_types,
+    DegenerateElement, Element, ElementResponse, ElementType, ElementTypeVisitor, GaussPoint,
+    Stabilisation, Tet4,
 };
 use crate::fbar::{
     fbar_cauchy_stress, fbar_element_response_with_history, fbar_gauss_point_c, Formulation,
@@ -51,9 +52,21 @@ pub struct ElementBlock<E, const N: usize, const G: usize> {
     element: PhantomData<fn() -> E>,
 }
 
-/// An empty block of element type `E`, as the element-type table builds them.
-pub fn new_block<E: Element<N, G>, const N: usize, const G: usize>() -> Box<dyn Block> {
-    Box::new(ElementBlock::<E, N, G>::empty())
+/// The empty blocks of the element types, one per type in the order of
+/// [`crate::element::ELEMENT_TYPES`].
+struct EmptyBlocks(Vec<Box<dyn Block>>);
+
+impl ElementTypeVisitor for EmptyBlocks {
+    fn visit<E: Element<N, G>, const N: usize, const G: usize>(&mut self) {
+        self.0.push(Box::new(ElementBlock::<E, N, G>::empty()));
+    }
+}
+
+/// An empty block of each element type, in the order of [`crate::element::ELEMENT_TYPES`].
+fn empty_blocks() -> Vec<Box<dyn Block>> {
+    let mut blocks = EmptyBlocks(Vec::new());
+    visit_element_types(&mut blocks);
+    blocks.0
 }
 
 impl<E: Element<N, G>, const N: usize, const G: usize> ElementBlock<E, N, G> {
@@ -447,8 +460,7 @@ impl Discretisation {
     ) -> Result<Self, Vec<BadElement>> {
         let mut node_offset = Vec::new();
         let mut reference = Vec::new();
-        let mut blocks: Vec<Box<dyn Block>> =
-            ELEMENT_TYPES.iter().map(|t| (t.new_block)()).collect();
+        let mut blocks = empty_blocks();
         let mut bad = Vec::new();
         for (bi, (mesh, material)) in bodies.iter().enumerate() {
             let off = reference.len();

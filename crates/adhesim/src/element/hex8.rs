@@ -39,7 +39,6 @@ pub static HEX8: ElementType = ElementType {
     },
     vtk_type: 12,
     gmsh_type: 5,
-    new_block: crate::assembly::new_block::<Hex8, 8, 8>,
 };
 
 /// The hex8 element at compile time.

@@ -2,9 +2,10 @@
 //!
 //! Every element type has two sides:
 //! - a row of the type table [`ELEMENT_TYPES`] ([`ElementType`]): its name, node count,
-//!   number of Gauss points, faces, VTK cell type and Gmsh element type, and a constructor of
-//!   its assembly block. Meshes, the Gmsh reader, VTK output and the discretisation only go
-//!   through this table;
+//!   number of Gauss points, faces, VTK cell type and Gmsh element type. Meshes, the Gmsh
+//!   reader, VTK output and the discretisation only go through this table, and the
+//!   discretisation builds one assembly block per row through [`visit_element_types`], which
+//!   hands it each row's Rust type (so this module never names the assembly);
 //! - an implementation of the [`Element`] trait (shape functions, Gauss rule, mass), with the
 //!   node count `N` and Gauss-point count `G` as const parameters, so that the kernels below
 //!   and the assembly loops are compiled for each type (no dynamic dispatch per element or
@@ -27,11 +28,36 @@ use crate::material::Hyperelastic;
 use crate::{Mat3, Vec3};
 use nalgebra::SMatrix;
 
-/// The element types adhesim knows, in the order cell blocks are kept in meshes, element
-/// blocks in the discretisation and cells in the output. A new element type is one file in
-/// this module (its [`Element`] implementation and its [`ElementType`] row) and one entry
-/// here.
-pub static ELEMENT_TYPES: &[&ElementType] = &[&HEX8, &TET4];
+/// The table of element types: each entry is an element's Rust type with its node and
+/// Gauss-point counts, and its [`ElementType`] row. It defines [`ELEMENT_TYPES`] and
+/// [`visit_element_types`] from the one list, so the two cannot disagree.
+macro_rules! element_types {
+    ($($element:ty, $nodes:literal, $points:literal, $row:expr;)*) => {
+        /// The element types adhesim knows, in the order cell blocks are kept in meshes,
+        /// element blocks in the discretisation and cells in the output. A new element type
+        /// is one file in this module (its [`Element`] implementation and its
+        /// [`ElementType`] row) and one entry in the table that defines this list.
+        pub static ELEMENT_TYPES: &[&ElementType] = &[$(&$row),*];
+
+        /// Calls `visitor` with the Rust type of each element type, in the order of
+        /// [`ELEMENT_TYPES`]: how code compiled for each type (the assembly's blocks) is
+        /// built without this module naming it.
+        pub fn visit_element_types(visitor: &mut impl ElementTypeVisitor) {
+            $(visitor.visit::<$element, $nodes, $points>();)*
+        }
+    };
+}
+
+element_types! {
+    Hex8, 8, 8, HEX8;
+    Tet4, 4, 1, TET4;
+}
+
+/// What is done with each element type's Rust type ([`visit_element_types`]).
+pub trait ElementTypeVisitor {
+    /// Called once per element type `E`, with `N` nodes and `G` Gauss points.
+    fn visit<E: Element<N, G>, const N: usize, const G: usize>(&mut self);
+}
 
 /// One row of the element-type table.
 pub struct ElementType {
@@ -63,8 +89,6 @@ pub struct ElementType {
     pub vtk_type: u8,
     /// Gmsh element type number (MSH 4.1).
     pub gmsh_type: i32,
-    /// An empty assembly block of this type, with the kernels compiled for it.
-    pub new_block: fn() -> Box<dyn crate::assembly::Block>,
 }
 
 /// The type's name: the `Debug` form of meshes (and so the checkpoint fingerprint of a
@@ -546,14 +570,27 @@ mod table_tests {
         }
     }
 
-    /// The table's name, node and Gmsh lookups find each row, and its block is of its type.
+    /// The table's name, node and Gmsh lookups find each row, and the visit of the types
+    /// goes through the rows in order, each with its own type and counts.
     #[test]
-    fn lookups_and_blocks_match_the_rows() {
+    fn lookups_and_visits_match_the_rows() {
         for (i, t) in ELEMENT_TYPES.iter().enumerate() {
             assert_eq!(t.index(), i);
             assert_eq!(ElementType::from_name(t.name), Some(*t));
             assert_eq!(ElementType::from_gmsh(t.gmsh_type), Some(*t));
-            assert_eq!((t.new_block)().element_type(), *t);
         }
+        struct Rows(Vec<(&'static ElementType, usize, usize)>);
+        impl ElementTypeVisitor for Rows {
+            fn visit<E: Element<N, G>, const N: usize, const G: usize>(&mut self) {
+                self.0.push((E::TYPE, N, G));
+            }
+        }
+        let mut rows = Rows(Vec::new());
+        visit_element_types(&mut rows);
+        let expected: Vec<_> = ELEMENT_TYPES
+            .iter()
+            .map(|t| (*t, t.nodes, t.gauss_points))
+            .collect();
+        assert_eq!(rows.0, expected);
     }
 }

@@ -22,7 +22,6 @@ pub static TET4: ElementType = ElementType {
     inverted_inside: |_| false,
     vtk_type: 10,
     gmsh_type: 4,
-    new_block: crate::assembly::new_block::<Tet4, 4, 1>,
 };
 
 /// The tet4 element at compile time.
