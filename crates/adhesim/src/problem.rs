@@ -1,5 +1,5 @@
 //! A validated problem: everything the stepper needs, in SI units, with node sets resolved
-//! to global node indices. Built from a scenario file by [`crate::scenario`], or directly
+//! to global node indices. Built from a scenario file by `adhesim_io::scenario`, or directly
 //! in code.
 
 use crate::material::Hyperelastic;
@@ -151,7 +151,7 @@ impl Default for TimeSettings {
 }
 
 /// Everything the stepper needs: the physics of a run (what it writes is
-/// [`crate::output::settings::OutputSettings`]).
+/// `adhesim_io::output::settings::OutputSettings`).
 #[derive(Clone, Debug)]
 pub struct Problem {
     /// Name of the run (file stem of outputs).

@@ -11,7 +11,8 @@
 use super::csv::read_history;
 use super::plot::{draw_scalar_map_with, ColorMap, PlotError, ScalarMap, ScalarValues};
 use super::{
-    contact_node_fields, contact_node_values, Observer, StepView, CONTACT_NODE_FIELDS, MAPS_KEY,
+    bad_state, contact_node_fields, contact_node_values, Observer, StepView, CONTACT_NODE_FIELDS,
+    MAPS_KEY,
 };
 use crate::codec::{Codec, Dec, Enc};
 use crate::output::settings::MapRequest;
@@ -89,15 +90,8 @@ impl MapObserver {
         let mut m = MapObserver::new(dir, requests)?;
         match state {
             Some(bytes) => {
-                m.read_state(bytes).map_err(|reason| {
-                    io::Error::new(
-                        io::ErrorKind::InvalidData,
-                        format!(
-                            "the {MAPS_KEY} output's resume state in the checkpoint is \
-                             damaged: {reason}"
-                        ),
-                    )
-                })?;
+                m.read_state(bytes)
+                    .map_err(|reason| bad_state(MAPS_KEY, reason))?;
             }
             None => {
                 for (r, req) in requests.iter().enumerate() {

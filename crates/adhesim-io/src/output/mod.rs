@@ -134,7 +134,7 @@ pub fn resume_observers(
 }
 
 /// An observer's resume state that cannot be read, as an I/O error of kind InvalidData.
-fn bad_state(key: &str, reason: String) -> io::Error {
+pub(crate) fn bad_state(key: &str, reason: String) -> io::Error {
     io::Error::new(
         io::ErrorKind::InvalidData,
         format!("the {key} output's resume state in the checkpoint is damaged: {reason}"),
