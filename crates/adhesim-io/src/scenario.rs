@@ -1684,11 +1684,7 @@ fn build_contact(
         slave_nodes,
         slave_area: area,
         master,
-        law: InterfaceLaw {
-            mu,
-            adhesion,
-            anisotropy,
-        },
+        law: InterfaceLaw::rcc(mu, adhesion, anisotropy),
         detection_distance,
         slave_quads,
         thickness_twins,

@@ -881,7 +881,12 @@ fn probe_sweep(
         }
     }
     let del = Delassus { w, m };
-    let laws: Vec<_> = stepper.problem.contacts.iter().map(|c| c.law).collect();
+    let laws: Vec<_> = stepper
+        .problem
+        .contacts
+        .iter()
+        .map(|c| c.law.clone())
+        .collect();
     let history0 = vec![PointHistory::default(); np];
     let x_free = vec![[0.0, 0.0, -1e-7]; np];
     let zero = vec![[0.0; 3]; np];

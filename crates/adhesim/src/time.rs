@@ -630,7 +630,12 @@ impl Stepper {
         let clock = Instant::now();
         let candidates = self.detect_contact(t1);
         let solver = candidates.solver;
-        let laws = self.problem.contacts.iter().map(|c| c.law).collect();
+        let laws = self
+            .problem
+            .contacts
+            .iter()
+            .map(|c| c.law.clone())
+            .collect();
         let reference = &self.disc.reference;
         let (contact, lambda) =
             StepContact::new(candidates, laws, dt, reference, &self.constraints);

@@ -291,11 +291,7 @@ fn indent_on(
                     rotation: None,
                 },
             },
-            law: InterfaceLaw {
-                mu: 0.0,
-                adhesion: None,
-                anisotropy: None,
-            },
+            law: InterfaceLaw::rcc(0.0, None, None),
             // The no-penetration check below covers every surface node, candidate or not.
             detection_distance: detection,
             slave_quads: vec![],

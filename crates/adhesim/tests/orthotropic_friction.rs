@@ -96,14 +96,14 @@ fn equal_coefficients_on_material_axes_reproduce_the_isotropic_law() {
 // The law at one point: the Gauss-Seidel point solve and the Newton solve's law.
 
 fn law(mu1: f64, mu2: f64) -> InterfaceLaw {
-    InterfaceLaw {
-        mu: mu1,
-        adhesion: None,
-        anisotropy: Some(Orthotropy {
+    InterfaceLaw::rcc(
+        mu1,
+        None,
+        Some(Orthotropy {
             axis: [1.0, 0.0, 0.0],
             mu2,
         }),
-    }
+    )
 }
 
 /// A point pushed along the plane with a stiff compliance slides; its friction force is
@@ -174,17 +174,13 @@ fn sliding_point_lands_on_the_ellipse_with_the_maximal_dissipation_direction() {
 fn equal_coefficients_reproduce_the_isotropic_law() {
     let mut rcc = RccParams::new(20.0, 2e9, 2e9, 0.1);
     rcc.ct2 = rcc.ct;
-    let iso = InterfaceLaw {
-        mu: 0.4,
-        adhesion: Some(rcc),
-        anisotropy: None,
-    };
+    let iso = InterfaceLaw::rcc(0.4, Some(rcc), None);
     let ortho = InterfaceLaw {
         anisotropy: Some(Orthotropy {
             axis: [1.0, 0.0, 0.0],
             mu2: 0.4,
         }),
-        ..iso
+        ..iso.clone()
     };
     let w = mat3_from_rows([[2e-6, 3e-7, 1e-7], [3e-7, 1e-6, -2e-7], [1e-7, -2e-7, 3e-6]]);
     for x_free in [

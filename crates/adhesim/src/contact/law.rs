@@ -35,6 +35,7 @@ use super::anisotropic::{scale, scale_matrix, unscale, unscale_matrix};
 use super::history::{HistoryField, LawHistory, LawPointHistory, NodeHistory, PointHistory};
 use crate::{Mat3, Vec2, Vec3};
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 /// Default bond cut-off ε of the RCC law: below it a bond is broken.
 pub const DEFAULT_BETA_EPS: f64 = 1e-4;
@@ -113,26 +114,61 @@ impl RccParams {
     }
 }
 
-/// Interface law of a contact pair.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Interface law of a contact pair: its friction cone (μ, and the material axes of an
+/// orthotropic interface) and the law of its bonds, which also keeps the history at each
+/// slave node ([`Interface`]).
+#[derive(Clone)]
 pub struct InterfaceLaw {
     /// Coulomb friction coefficient μ ≥ 0 [-] (negative values are treated as 0); μ₁, along
     /// the first material axis, on an orthotropic interface.
     pub mu: f64,
-    /// RCC adhesion, or `None` for dry contact.
-    pub adhesion: Option<RccParams>,
+    /// The bond law: RCC adhesion ([`super::rcc::Rcc`], without parameters for dry contact)
+    /// or any other implementation of [`Interface`].
+    pub bond: Arc<dyn Interface>,
     /// Material axes and μ₂ of an orthotropic interface (elliptic friction cone), or `None`
     /// for an isotropic one ([`super::anisotropic`]).
     pub anisotropy: Option<Orthotropy>,
 }
 
+/// The form the checkpoint fingerprint hashes: the bond law's under the name `adhesion`
+/// (`None` or `Some(RccParams { .. })` for RCC), as when RCC was the only law, so that a
+/// scenario's fingerprint does not change with this layout.
+impl std::fmt::Debug for InterfaceLaw {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("InterfaceLaw")
+            .field("mu", &self.mu)
+            .field("adhesion", &self.bond)
+            .field("anisotropy", &self.anisotropy)
+            .finish()
+    }
+}
+
+/// Two laws are equal when their cones are and their bond laws describe themselves alike.
+impl PartialEq for InterfaceLaw {
+    fn eq(&self, other: &Self) -> bool {
+        self.mu == other.mu
+            && self.anisotropy == other.anisotropy
+            && format!("{:?}", self.bond) == format!("{:?}", other.bond)
+    }
+}
+
 impl InterfaceLaw {
     /// Dry isotropic Coulomb friction with coefficient `mu` [-]: no adhesion, no anisotropy.
     pub fn coulomb(mu: f64) -> Self {
+        Self::rcc(mu, None, None)
+    }
+
+    /// Coulomb friction `mu` [-] with RCC adhesion `adhesion` (None: dry) and the orthotropy
+    /// `anisotropy` (None: isotropic).
+    pub fn rcc(mu: f64, adhesion: Option<RccParams>, anisotropy: Option<Orthotropy>) -> Self {
+        let bond: Arc<dyn Interface> = match adhesion {
+            Some(_) => Arc::new(super::rcc::Rcc(adhesion)),
+            None => super::rcc::Rcc::dry(),
+        };
         InterfaceLaw {
             mu,
-            adhesion: None,
-            anisotropy: None,
+            bond,
+            anisotropy,
         }
     }
 
@@ -157,22 +193,24 @@ impl InterfaceLaw {
 /// [`BondState`] for RCC); the solvers pass it from [`Interface::point_history`] to the
 /// adhesive evaluations and from those, in the point's solution, to [`Interface::commit`].
 ///
-/// Every point solver reaches the adhesive part only through this trait, statically: the
+/// Every point solver reaches the adhesive part only through this trait: the
 /// Gauss-Seidel point solver ([`solve_point`], implicit in x) through
 /// [`Interface::is_adhesive`], [`Interface::adhesion_at`], [`Interface::frozen_springs`] and
 /// [`Interface::bond_traction`], the fclib Newton and the mixed solve through
 /// [`Interface::adhesive_response`].
 ///
-/// The RCC law, with dry Coulomb friction as its case without adhesion, implements it in
-/// `rcc.rs`; a law's history is registered in [`REGISTERED_HISTORIES`].
-pub trait Interface {
-    /// The law's history at a slave node.
-    type History: LawHistory;
+/// A contact pair holds its bond law as a trait object ([`InterfaceLaw::bond`]), and
+/// [`InterfaceLaw`] implements the trait by handing each call to it: a new law is a type that
+/// implements it in a file of its own, with its history registered in
+/// [`REGISTERED_HISTORIES`]. The RCC law ([`super::rcc::Rcc`], with dry Coulomb friction as its
+/// case without adhesion) implements it in `rcc.rs`. Its `Debug` form is part of the
+/// checkpoint fingerprint of a problem, so it must show every parameter.
+pub trait Interface: std::fmt::Debug + Send + Sync {
+    /// The named fields of the law's history at a slave node (its [`LawHistory::FIELDS`]).
+    fn history_fields(&self) -> &'static [HistoryField];
 
-    /// The named fields of the history.
-    fn history_fields(&self) -> &'static [HistoryField] {
-        Self::History::FIELDS
-    }
+    /// The law as [`std::any::Any`], to reach the parameters of a law of a known type.
+    fn as_any(&self) -> &dyn std::any::Any;
 
     /// Largest quasi-static traction of the law's bonds [Pa] (0 without adhesion): times a
     /// point's area, the force its bond can carry.
@@ -254,6 +292,64 @@ pub struct PairScales<'a> {
     pub poisson: f64,
     /// Mean slave edge h [m].
     pub edge: f64,
+}
+
+/// A contact pair's law is its bond law's, whatever that is.
+impl Interface for InterfaceLaw {
+    fn history_fields(&self) -> &'static [HistoryField] {
+        self.bond.history_fields()
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self.bond.as_any()
+    }
+
+    fn bond_traction(&self) -> f64 {
+        self.bond.bond_traction()
+    }
+
+    fn is_adhesive(&self) -> bool {
+        self.bond.is_adhesive()
+    }
+
+    fn adhesion_at(&self, start: &PointHistory, dt: f64, area: f64, x: Vec3) -> AdhEval {
+        self.bond.adhesion_at(start, dt, area, x)
+    }
+
+    fn frozen_springs(&self, start: &PointHistory, area: f64) -> Option<FrozenSprings> {
+        self.bond.frozen_springs(start, area)
+    }
+
+    fn warnings(&self, pair: &PairScales, out: &mut Vec<String>) {
+        self.bond.warnings(pair, out)
+    }
+
+    fn adhesive_response(
+        &self,
+        start: &PointHistory,
+        dt: f64,
+        area: f64,
+        x: Vec3,
+    ) -> Option<AdhesiveResponse> {
+        self.bond.adhesive_response(start, dt, area, x)
+    }
+
+    fn point_history(&self, node: &NodeHistory, frame: &[[f64; 3]; 3]) -> PointHistory {
+        self.bond.point_history(node, frame)
+    }
+
+    fn commit(
+        &self,
+        start: &PointHistory,
+        sol: &PointSolution,
+        frame: &[[f64; 3]; 3],
+    ) -> NodeHistory {
+        self.bond.commit(start, sol, frame)
+    }
+
+    fn release(&self, node: &NodeHistory) -> NodeHistory {
+        self.bond.release(node)
+    }
 }
 
 /// The history fields of every registered interface law.
@@ -620,7 +716,7 @@ fn solve_point_impl(
     }
     let law = InterfaceLaw {
         anisotropy: None,
-        ..*p.law
+        ..p.law.clone()
     };
     let scaled = PointProblem {
         w_aa: scale_matrix(p.w_aa, s),
@@ -1474,11 +1570,8 @@ mod tests {
         assert!((a - b).norm() <= tol * s, "{a:?} vs {b:?} (tol {tol})");
     }
 
-    const DRY: InterfaceLaw = InterfaceLaw {
-        mu: 0.3,
-        adhesion: None,
-        anisotropy: None,
-    };
+    static DRY: std::sync::LazyLock<InterfaceLaw> =
+        std::sync::LazyLock::new(|| InterfaceLaw::coulomb(0.3));
 
     /// Paper-like interface: w = 20 J/m², C_n = C_t = 2e9 N/m³ (x_c = 0.1 mm), b = 0.1 N·s/m.
     fn paper_rcc() -> RccParams {
@@ -1500,6 +1593,97 @@ mod tests {
             area: 1e-6,
             rho: default_rho(w),
         }
+    }
+
+    /// A bond law that is not RCC, defined here and nowhere else: a linear spring of
+    /// stiffness k per unit area [N/m³] on the normal opening, always bonded, with no
+    /// history. Plugged into a pair's law, the point solver uses it as it uses RCC.
+    #[derive(Debug)]
+    struct NormalSpring {
+        k: f64,
+    }
+
+    impl Interface for NormalSpring {
+        fn history_fields(&self) -> &'static [HistoryField] {
+            &[]
+        }
+        fn as_any(&self) -> &dyn std::any::Any {
+            self
+        }
+        fn bond_traction(&self) -> f64 {
+            self.k * 1e-3
+        }
+        fn is_adhesive(&self) -> bool {
+            true
+        }
+        fn adhesion_at(&self, _: &PointHistory, _: f64, area: f64, x: Vec3) -> AdhEval {
+            let ka = self.k * area;
+            let mut history = PointHistory::default();
+            history.0[0] = 1.0;
+            AdhEval {
+                history,
+                force: v3(0.0, 0.0, -ka * x[2]),
+                stiff: Mat3::from_diagonal(&v3(0.0, 0.0, ka)),
+                energy: 0.5 * ka * x[2] * x[2],
+            }
+        }
+        fn frozen_springs(&self, _: &PointHistory, area: f64) -> Option<FrozenSprings> {
+            Some(FrozenSprings {
+                stiffness: v3(0.0, 0.0, self.k * area),
+                stretch: Vec2::zeros(),
+            })
+        }
+        fn adhesive_response(
+            &self,
+            start: &PointHistory,
+            dt: f64,
+            area: f64,
+            x: Vec3,
+        ) -> Option<AdhesiveResponse> {
+            let e = self.adhesion_at(start, dt, area, x);
+            Some(AdhesiveResponse {
+                history: e.history,
+                force: e.force,
+                secant_stiffness: e.stiff,
+                energy: e.energy,
+            })
+        }
+        fn point_history(&self, _: &NodeHistory, _: &[[f64; 3]; 3]) -> PointHistory {
+            PointHistory::default()
+        }
+        fn commit(&self, _: &PointHistory, _: &PointSolution, _: &[[f64; 3]; 3]) -> NodeHistory {
+            NodeHistory::default()
+        }
+        fn release(&self, _: &NodeHistory) -> NodeHistory {
+            NodeHistory::default()
+        }
+    }
+
+    /// A point pulled open (x_free along +n) against a bond law of its own: the dry force is
+    /// zero and the spring's force −kA x_n n gives x_n = x_free,n / (1 + W_nn k A) (W
+    /// diagonal), with no tangential force; the solver reaches the new law only through the
+    /// pair's `InterfaceLaw`. Tolerance 1e-9 relative: the point solver's own.
+    #[test]
+    fn a_bond_law_of_its_own_is_solved_through_the_pair_law() {
+        let law = InterfaceLaw {
+            mu: 0.3,
+            bond: Arc::new(NormalSpring { k: 2e12 }),
+            anisotropy: None,
+        };
+        let w = Mat3::from_diagonal(&v3(1e-6, 1e-6, 2e-6));
+        let x_free = v3(0.0, 0.0, 1e-5);
+        let p = problem(&law, w, x_free, BondState::default());
+        let s = solve_point(&p, Vec3::zeros(), 1e-12, 100);
+        assert!(s.converged);
+        assert_eq!(s.state, ContactState::Apart);
+        assert_eq!(s.r_dry, Vec3::zeros());
+        let ka = 2e12 * p.area;
+        let xn = 1e-5 / (1.0 + 2e-6 * ka);
+        assert!((s.x[2] - xn).abs() <= 1e-9 * xn, "{} vs {xn}", s.x[2]);
+        assert!((s.r_adh[2] + ka * xn).abs() <= 1e-9 * ka * xn);
+        assert_eq!((s.r_adh[0], s.r_adh[1]), (0.0, 0.0));
+        assert!(s.bonded());
+        assert_eq!(format!("{law:?}").matches("NormalSpring").count(), 1);
     }
 
     /// Independent check of a point solution against the laws of docs/model.md §5: x = x_free + W r,
@@ -1540,7 +1724,13 @@ mod tests {
                 }
             }
         }
-        match &p.law.adhesion {
+        let adhesion = p
+            .law
+            .as_any()
+            .downcast_ref::<super::super::rcc::Rcc>()
+            .unwrap()
+            .0;
+        match &adhesion {
             None => assert_eq!(s.r_adh, Vec3::zeros()),
             Some(a) => {
                 let (b0, b1) = (BondState::decode(&p.history0), end(s));
@@ -1911,11 +2101,7 @@ mod tests {
         // Δt = 1 s): the tensile force follows A·C_n x min(1, w/(C_n x²))² at the solved gap and
         // peaks at A·√(C_n w).
         let rcc = RccParams::new(20.0, 2e9, 2e9, 1e-6);
-        let law = InterfaceLaw {
-            mu: 0.3,
-            adhesion: Some(rcc),
-            anisotropy: None,
-        };
+        let law = InterfaceLaw::rcc(0.3, Some(rcc), None);
         let xc = rcc.critical_opening();
         let area = 1e-6;
         let w = diag(1e-6, 1e-6, 1e-6);
@@ -1955,11 +2141,7 @@ mod tests {
         // C_t A W_tt = C_n A W_nn = 100, bonded (β₀ = 1) with a stretched link, pressed and
         // sheared: stick below the friction limit, slide above; the answer comes in ≤ 8
         // iterations either way.
-        let law = InterfaceLaw {
-            mu: 0.4,
-            adhesion: Some(paper_rcc()),
-            anisotropy: None,
-        };
+        let law = InterfaceLaw::rcc(0.4, Some(paper_rcc()), None);
         let w = diag(0.05, 0.05, 0.05);
         let bond = BondState {
             beta: 1.0,
@@ -2033,11 +2215,7 @@ mod tests {
         assert_vec_close(s.x, v3(2.1e-5, 2.8e-5, 0.0), 1e-10);
         check_solution(&p, &s, 1e-10);
         // Frictionless: r_t = 0, all of x_free_t becomes slip.
-        let law = InterfaceLaw {
-            mu: 0.0,
-            adhesion: None,
-            anisotropy: None,
-        };
+        let law = InterfaceLaw::rcc(0.0, None, None);
         let p = problem(&law, w, v3(3e-5, 4e-5, -1e-4), BondState::default());
         let s = solve_point(&p, Vec3::zeros(), 1e-12, 50);
         assert!(s.converged);
@@ -2059,11 +2237,7 @@ mod tests {
 
     #[test]
     fn bonded_point_opened_slightly_pulls_back() {
-        let law = InterfaceLaw {
-            mu: 0.3,
-            adhesion: Some(paper_rcc()),
-            anisotropy: None,
-        };
+        let law = InterfaceLaw::rcc(0.3, Some(paper_rcc()), None);
         let bond = BondState {
             beta: 1.0,
             ut: Vec2::zeros(),
@@ -2088,11 +2262,7 @@ mod tests {
 
     #[test]
     fn bond_stretch_bookkeeping() {
-        let law = InterfaceLaw {
-            mu: 0.3,
-            adhesion: Some(paper_rcc()),
-            anisotropy: None,
-        };
+        let law = InterfaceLaw::rcc(0.3, Some(paper_rcc()), None);
         let w = diag(1e-4, 1e-4, 1e-4);
         // Bonded, pressed and pulled sideways: stretch grows by the slip, bond survives.
         let bond = BondState {
@@ -2144,11 +2314,7 @@ mod tests {
             };
             let mu = [0.0, 0.2, 0.4, 0.8, 1.2][(i / 10) % 5];
             let rcc = RccParams::new(20.0, 2e9, 2e9, v3(0.1, 1e-6, 0.0)[(i / 50) % 3]);
-            let law = InterfaceLaw {
-                mu,
-                adhesion: if ratio > 0.0 { Some(rcc) } else { None },
-                anisotropy: None,
-            };
+            let law = InterfaceLaw::rcc(mu, if ratio > 0.0 { Some(rcc) } else { None }, None);
             let xc = rcc.critical_opening();
             let a = 10f64.powf(rng.uniform(-2.0, 0.7)) * xc * (1.0 + ratio);
             let x_free = v3(
@@ -2227,11 +2393,7 @@ mod tests {
         let mut worst = 0;
         for i in 0..300 {
             let w = rng.spd(1e-6, 1e-5);
-            let law = InterfaceLaw {
-                mu: v3(0.0, 0.3, 0.8)[i % 3],
-                adhesion: None,
-                anisotropy: None,
-            };
+            let law = InterfaceLaw::rcc(v3(0.0, 0.3, 0.8)[i % 3], None, None);
             let x_free = v3(
                 rng.uniform(-1e-4, 1e-4),
                 rng.uniform(-1e-4, 1e-4),
@@ -2263,11 +2425,7 @@ mod tests {
         // exceeds 2/λ_max and the sticking iteration r ← r − ρ W r − ρ x_free diverges.
         let eps = 0.05;
         let w = Mat3::from_fn(|i, j| (1.0 - eps) / 3.0 + if i == j { eps } else { 0.0 });
-        let law = InterfaceLaw {
-            mu: 1.0,
-            adhesion: None,
-            anisotropy: None,
-        };
+        let law = InterfaceLaw::rcc(1.0, None, None);
         let mut p = problem(&law, w, v3(0.0, 0.0, -1.0), BondState::default());
         let ok = solve_point_impl(
             &p,
@@ -2301,11 +2459,7 @@ mod tests {
         // 100 x_c) and the point stays on the far branch x + 100 x_c⁴/x³ = a until its turning
         // point a* = (4/3)·300^{1/4} x_c ≈ 5.55 x_c, where it snaps back into the bonded branch.
         let rcc = RccParams::new(20.0, 2e9, 2e9, 1e-6);
-        let law = InterfaceLaw {
-            mu: 0.3,
-            adhesion: Some(rcc),
-            anisotropy: None,
-        };
+        let law = InterfaceLaw::rcc(0.3, Some(rcc), None);
         let xc = rcc.critical_opening();
         let w = diag(0.05, 0.05, 0.05);
         let mut bond = BondState {
@@ -2359,11 +2513,7 @@ mod tests {
     #[test]
     fn degenerate_inputs_do_not_panic() {
         let rcc = paper_rcc();
-        let law = InterfaceLaw {
-            mu: 0.5,
-            adhesion: Some(rcc),
-            anisotropy: None,
-        };
+        let law = InterfaceLaw::rcc(0.5, Some(rcc), None);
         let bond = BondState {
             beta: 1.0,
             ut: Vec2::new(1e-5, 0.0),

@@ -556,19 +556,15 @@ mod tests {
         .encode();
         let laws = [
             InterfaceLaw::coulomb(0.3),
-            InterfaceLaw {
-                mu: 0.5,
-                adhesion: Some(rcc),
-                anisotropy: None,
-            },
-            InterfaceLaw {
-                mu: 0.3,
-                adhesion: None,
-                anisotropy: Some(Orthotropy {
+            InterfaceLaw::rcc(0.5, Some(rcc), None),
+            InterfaceLaw::rcc(
+                0.3,
+                None,
+                Some(Orthotropy {
                     axis: [1.0, 0.0, 0.0],
                     mu2: 0.6,
                 }),
-            },
+            ),
         ];
         let rho = 1e3;
         // (r, x) of a stick, a slide and a separating point.

@@ -274,11 +274,7 @@ mod tests {
     use crate::Vec2;
 
     fn dry(mu: f64) -> InterfaceLaw {
-        InterfaceLaw {
-            mu,
-            adhesion: None,
-            anisotropy: None,
-        }
+        InterfaceLaw::rcc(mu, None, None)
     }
 
     /// One point on a spring k pushed into a rigid wall, x_n = x_free + r_n/k: the
@@ -351,11 +347,7 @@ mod tests {
     #[test]
     fn adhesion_adds_its_force_and_secant_stiffness() {
         let a = RccParams::new(20.0, 2e9, 1e9, 0.1);
-        let law = InterfaceLaw {
-            mu: 0.0,
-            adhesion: Some(a),
-            anisotropy: None,
-        };
+        let law = InterfaceLaw::rcc(0.0, Some(a), None);
         let bond0 = BondState {
             beta: 1.0,
             ut: Vec2::new(1e-7, 0.0),

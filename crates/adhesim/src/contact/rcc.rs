@@ -15,9 +15,10 @@ use super::history::{
 };
 use super::law::{
     accumulated_damage, adhesive_response, clamp01, rcc_adhesion_at, AdhEval, AdhesiveResponse,
-    BondState, FrozenSprings, Interface, InterfaceLaw, PairScales, PointSolution,
+    BondState, FrozenSprings, Interface, PairScales, PointSolution, RccParams,
 };
 use crate::{Vec2, Vec3};
+use std::sync::{Arc, OnceLock};
 
 /// Warn when C_n·A exceeds this many times E·h (per slave node).
 pub const CN_STIFFNESS_RATIO: f64 = 1e4;
@@ -90,26 +91,52 @@ impl From<&NodeHistory> for RccHistory {
     }
 }
 
-impl Interface for InterfaceLaw {
-    type History = RccHistory;
+/// The RCC bond law with its parameters, or without (`None`): dry contact, whose nodes keep
+/// the RCC history (β = 0, no stretch, the damage they had).
+#[derive(Clone, Copy, PartialEq)]
+pub struct Rcc(pub Option<RccParams>);
+
+impl Rcc {
+    /// The law of dry contact, shared: one allocation for the whole program.
+    pub fn dry() -> Arc<dyn Interface> {
+        static DRY: OnceLock<Arc<dyn Interface>> = OnceLock::new();
+        DRY.get_or_init(|| Arc::new(Rcc(None))).clone()
+    }
+}
+
+/// As the parameters: `None` or `Some(RccParams { .. })`.
+impl std::fmt::Debug for Rcc {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+impl Interface for Rcc {
+    fn history_fields(&self) -> &'static [HistoryField] {
+        RccHistory::FIELDS
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
 
     fn bond_traction(&self) -> f64 {
-        self.adhesion.map_or(0.0, |a| a.peak_traction())
+        self.0.map_or(0.0, |a| a.peak_traction())
     }
 
     fn is_adhesive(&self) -> bool {
-        self.adhesion.is_some()
+        self.0.is_some()
     }
 
     fn adhesion_at(&self, start: &PointHistory, dt: f64, area: f64, x: Vec3) -> AdhEval {
-        match &self.adhesion {
+        match &self.0 {
             Some(a) => rcc_adhesion_at(BondState::decode(start), dt, area, a, x),
             None => AdhEval::default(),
         }
     }
 
     fn warnings(&self, pair: &PairScales, out: &mut Vec<String>) {
-        let (Some(a), Some(area)) = (&self.adhesion, pair.mean_area) else {
+        let (Some(a), Some(area)) = (&self.0, pair.mean_area) else {
             return;
         };
         let (e, nu, h) = (pair.young, pair.poisson, pair.edge);
@@ -135,7 +162,7 @@ impl Interface for InterfaceLaw {
 
     /// Springs A β₀² (C_t, C_t2, C_n) at the undegraded stiffnesses, stretched by u_t0.
     fn frozen_springs(&self, start: &PointHistory, area: f64) -> Option<FrozenSprings> {
-        let a = self.adhesion.as_ref()?;
+        let a = self.0.as_ref()?;
         let start = BondState::decode(start);
         let b0 = clamp01(start.beta);
         let k = area * b0 * b0;
@@ -155,7 +182,7 @@ impl Interface for InterfaceLaw {
         area: f64,
         x: Vec3,
     ) -> Option<AdhesiveResponse> {
-        self.adhesion
+        self.0
             .as_ref()
             .map(|a| adhesive_response(a, BondState::decode(start), dt, area, x))
     }
@@ -181,7 +208,7 @@ impl Interface for InterfaceLaw {
         frame: &[[f64; 3]; 3],
     ) -> NodeHistory {
         let end = BondState::decode(&sol.history);
-        let damage = match &self.adhesion {
+        let damage = match &self.0 {
             Some(_) => end.damage,
             None => BondState::decode(start).damage,
         };
@@ -199,7 +226,7 @@ impl Interface for InterfaceLaw {
 
     fn release(&self, node: &NodeHistory) -> NodeHistory {
         let h = RccHistory::decode(node);
-        let damage = match &self.adhesion {
+        let damage = match &self.0 {
             Some(a) => accumulated_damage(h.damage, h.beta, 0.0, a),
             None => h.damage,
         };
@@ -263,11 +290,11 @@ mod tests {
     /// the two rotations, 1e-15 of its length.
     #[test]
     fn node_history_through_the_point_frame_and_back() {
-        let law = InterfaceLaw {
-            mu: 0.3,
-            adhesion: Some(RccParams::new(20.0, 2e9, 2e9, 0.1)),
-            anisotropy: None,
-        };
+        let law = super::super::law::InterfaceLaw::rcc(
+            0.3,
+            Some(RccParams::new(20.0, 2e9, 2e9, 0.1)),
+            None,
+        );
         let (c, s) = (0.6_f64, 0.8_f64);
         // Rows t₁, t₂, n: orthonormal, n = t₁ × t₂.
         let frame = [[c, s, 0.0], [0.0, 0.0, 1.0], [s, -c, 0.0]];

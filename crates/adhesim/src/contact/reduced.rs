@@ -212,17 +212,14 @@ pub fn gauss_seidel_sweep(
     rho: &[f64],
     r: &mut [[f64; 3]],
 ) {
+    let laws: Vec<InterfaceLaw> = mu.iter().map(|&m| InterfaceLaw::coulomb(m)).collect();
     for p in 0..w.points() {
         let x_free = w.row_times(p, r, q[p], Some(p));
-        let law = InterfaceLaw {
-            mu: mu[p],
-            adhesion: None,
-            anisotropy: None,
-        };
+        let law = &laws[p];
         let problem = PointProblem {
             w_aa: mat3_from_rows(w.diagonal_block(p)),
             x_free: x_free.into(),
-            law: &law,
+            law,
             history0: PointHistory::default(),
             dt: 1.0,
             area: 1.0,
