@@ -15,7 +15,9 @@
 
 use crate::codec::{Codec, Dec, Enc};
 use crate::output::settings::OutputSettings;
-use crate::output::{FrameProgress, HistoryObserver, SavedObserver, FRAMES_KEY, HISTORY_KEY};
+use crate::output::{
+    saved_state, FrameProgress, HistoryObserver, SavedObserver, FRAMES_KEY, HISTORY_KEY,
+};
 use adhesim::contact::history::MAX_HISTORY_VALUES;
 use adhesim::problem::Problem;
 use adhesim::time::{CachedDelassus, DelassusCache, NodeContact, Snapshot};
@@ -151,10 +153,7 @@ impl Checkpoint {
 
     /// The resume state saved by the observer whose key is `key`, if any.
     pub fn observer_state(&self, key: &str) -> Option<&[u8]> {
-        self.observers
-            .iter()
-            .find(|o| o.key == key)
-            .map(|o| &o.state[..])
+        saved_state(&self.observers, key)
     }
 
     /// Checks that the checkpoint in `dir` was written by this version for the run whose
@@ -264,12 +263,7 @@ impl Checkpoint {
             wall_time: 0.0,
         };
         checkpoint.visit(&mut r, format)?;
-        if r.pos != body.len() {
-            return Err(format!(
-                "{} unexpected bytes after the last field",
-                body.len() - r.pos
-            ));
-        }
+        r.finish()?;
         Ok(checkpoint)
     }
 
@@ -341,17 +335,11 @@ impl Checkpoint {
 /// The observers' states as formats 4 to 6 held them: the frame writer's progress inline,
 /// then the rows of history.csv; the contact maps kept none (they resume from the time).
 fn legacy_observers(c: &mut impl Codec, observers: &mut Vec<SavedObserver>) -> Result<(), String> {
-    let saved = |key: &str| {
-        observers
-            .iter()
-            .find(|o| o.key == key)
-            .map(|o| &o.state[..])
-    };
-    let mut frames = match saved(FRAMES_KEY) {
+    let mut frames = match saved_state(observers, FRAMES_KEY) {
         Some(s) => FrameProgress::from_bytes(s)?,
         None => FrameProgress::default(),
     };
-    let mut rows = match saved(HISTORY_KEY) {
+    let mut rows = match saved_state(observers, HISTORY_KEY) {
         Some(s) => HistoryObserver::rows_in_state(s)?,
         None => 0,
     };

@@ -131,3 +131,21 @@ impl<'a> Dec<'a> {
         }
     }
 }
+
+/// The bytes that `write` puts through an [`Enc`].
+pub(crate) fn encode_with(write: impl FnOnce(&mut Enc) -> Result<(), String>) -> Vec<u8> {
+    let mut e = Enc(Vec::new());
+    write(&mut e).expect("writing to memory cannot fail");
+    e.0
+}
+
+/// What `read` takes from `bytes` through a [`Dec`], which must use every byte.
+pub(crate) fn decode_with<T>(
+    bytes: &[u8],
+    read: impl FnOnce(&mut Dec) -> Result<T, String>,
+) -> Result<T, String> {
+    let mut d = Dec::new(bytes);
+    let value = read(&mut d)?;
+    d.finish()?;
+    Ok(value)
+}

@@ -14,7 +14,7 @@ use super::{
     bad_state, contact_node_fields, contact_node_values, Observer, StepView, CONTACT_NODE_FIELDS,
     MAPS_KEY,
 };
-use crate::codec::{Codec, Dec, Enc};
+use crate::codec::{decode_with, encode_with, Codec};
 use crate::output::settings::MapRequest;
 use adhesim::contact::history::{self, FieldKind, HistoryField};
 use adhesim::contact::Interface;
@@ -127,10 +127,11 @@ impl MapObserver {
     /// Reads the state written by [`Observer::resume_state`] into `self`, which must have as
     /// many requests.
     fn read_state(&mut self, bytes: &[u8]) -> Result<(), String> {
-        let (mut next, mut faces) = (Vec::new(), Vec::new());
-        let mut d = Dec::new(bytes);
-        Self::visit(&mut next, &mut faces, &mut d)?;
-        d.finish()?;
+        let (next, faces) = decode_with(bytes, |d| {
+            let (mut next, mut faces) = (Vec::new(), Vec::new());
+            Self::visit(&mut next, &mut faces, d)?;
+            Ok((next, faces))
+        })?;
         if next.len() != self.requests.len() {
             return Err(format!(
                 "it holds {} map requests, the scenario {}",
@@ -154,14 +155,7 @@ impl Observer for MapObserver {
     }
 
     fn resume_state(&self) -> Vec<u8> {
-        let mut e = Enc(Vec::new());
-        Self::visit(
-            &mut self.next.clone(),
-            &mut self.faces_written.clone(),
-            &mut e,
-        )
-        .expect("writing to memory cannot fail");
-        e.0
+        encode_with(|e| Self::visit(&mut self.next.clone(), &mut self.faces_written.clone(), e))
     }
 
     fn observe(&mut self, view: &StepView) -> io::Result<()> {

@@ -9,7 +9,7 @@ pub mod plot;
 pub mod settings;
 pub mod vtk;
 
-use crate::codec::{Codec, Dec, Enc};
+use crate::codec::{decode_with, encode_with, Codec};
 use adhesim::assembly::Discretisation;
 use adhesim::contact::history::{FieldKind, HistoryField, Slot};
 use adhesim::contact::{Interface, Master, RigidShape};
@@ -67,6 +67,11 @@ pub struct SavedObserver {
     pub state: Vec<u8>,
 }
 
+/// The state saved under `key` among `saved`, if any.
+pub fn saved_state<'a>(saved: &'a [SavedObserver], key: &str) -> Option<&'a [u8]> {
+    saved.iter().find(|s| s.key == key).map(|s| &s.state[..])
+}
+
 /// Key of the [`FrameWriter`].
 pub const FRAMES_KEY: &str = "frames";
 /// Key of the [`HistoryObserver`].
@@ -102,9 +107,8 @@ pub fn resume_observers(
     saved: &[SavedObserver],
     t: f64,
 ) -> io::Result<Vec<Box<dyn Observer>>> {
-    let state = |key: &str| saved.iter().find(|s| s.key == key).map(|s| &s.state[..]);
     let required = |key: &str| {
-        state(key).ok_or_else(|| {
+        saved_state(saved, key).ok_or_else(|| {
             io::Error::new(
                 io::ErrorKind::InvalidData,
                 format!("the checkpoint holds no resume state for the {key} output"),
@@ -127,7 +131,7 @@ pub fn resume_observers(
         Box::new(maps::MapObserver::resume(
             dir,
             &output.maps,
-            state(MAPS_KEY),
+            saved_state(saved, MAPS_KEY),
             t,
         )?),
     ])
@@ -239,20 +243,16 @@ impl FrameProgress {
 
     /// Its bytes, the [`FrameWriter`]'s resume state.
     pub fn to_bytes(&self) -> Vec<u8> {
-        let mut e = Enc(Vec::new());
-        self.clone()
-            .visit(&mut e)
-            .expect("writing to memory cannot fail");
-        e.0
+        encode_with(|e| self.clone().visit(e))
     }
 
     /// The progress whose [`FrameProgress::to_bytes`] are `bytes`; Err says what is wrong.
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, String> {
-        let mut p = FrameProgress::default();
-        let mut d = Dec::new(bytes);
-        p.visit(&mut d)?;
-        d.finish()?;
-        Ok(p)
+        decode_with(bytes, |d| {
+            let mut p = FrameProgress::default();
+            p.visit(d)?;
+            Ok(p)
+        })
     }
 }
 
@@ -937,16 +937,16 @@ impl HistoryObserver {
 
     /// The resume state of a history with `rows` rows written (the row at t = 0 included).
     pub fn state_of_rows(rows: u64) -> Vec<u8> {
-        rows.to_le_bytes().to_vec()
+        encode_with(|e| e.u64(&mut { rows }))
     }
 
     /// The rows counted by the resume state `state` ([`HistoryObserver::state_of_rows`]).
     pub fn rows_in_state(state: &[u8]) -> Result<u64, String> {
-        let mut rows = 0;
-        let mut d = Dec::new(state);
-        d.u64(&mut rows)?;
-        d.finish()?;
-        Ok(rows)
+        decode_with(state, |d| {
+            let mut rows = 0;
+            d.u64(&mut rows)?;
+            Ok(rows)
+        })
     }
 }
 

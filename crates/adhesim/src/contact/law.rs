@@ -143,15 +143,6 @@ impl std::fmt::Debug for InterfaceLaw {
     }
 }
 
-/// Two laws are equal when their cones are and their bond laws describe themselves alike.
-impl PartialEq for InterfaceLaw {
-    fn eq(&self, other: &Self) -> bool {
-        self.mu == other.mu
-            && self.anisotropy == other.anisotropy
-            && format!("{:?}", self.bond) == format!("{:?}", other.bond)
-    }
-}
-
 impl InterfaceLaw {
     /// Dry isotropic Coulomb friction with coefficient `mu` [-]: no adhesion, no anisotropy.
     pub fn coulomb(mu: f64) -> Self {
@@ -660,7 +651,7 @@ struct Eval {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct AdhEval {
     /// The point history the step leads to at this x (for RCC: β₁, the bond stretch
-    /// u_t0 + x_t while bonded, else 0, and D).
+    /// u_t0 + x_t while bonded, else 0, and D as at the start, which the commit accumulates).
     pub history: PointHistory,
     /// Adhesive force r̃ [N].
     pub force: Vec3,
@@ -1134,9 +1125,10 @@ pub(super) fn rcc_adhesion_at(
 
 /// The RCC law `a` at `x` from the committed bond state `bond0`, Δt [s] and tributary area
 /// [m²]: the bond state the step leads to (β₁; the stretch u_t0 + x_t while bonded, else 0;
-/// D after β₀ → β₁, [`accumulated_damage`]) and the evaluation, whose history is that state.
+/// D as at the start: the energy dissipated by β₀ → β₁ is added once, when the step is
+/// committed, not at every evaluation of the point solvers) and the evaluation, whose
+/// history is that state.
 fn rcc_step(bond0: BondState, dt: f64, area: f64, a: &RccParams, x: Vec3) -> (BondState, AdhEval) {
-    let undegraded = a;
     let a = &a.degraded(bond0.damage);
     let ut = bond0.ut + x.xy();
     let e = stretch_energy(a, x[2], ut);
@@ -1164,7 +1156,7 @@ fn rcc_step(bond0: BondState, dt: f64, area: f64, a: &RccParams, x: Vec3) -> (Bo
     let end = BondState {
         beta,
         ut: if beta > 0.0 { ut } else { Vec2::zeros() },
-        damage: accumulated_damage(bond0.damage, bond0.beta, beta, undegraded),
+        damage: bond0.damage,
     };
     let ev = AdhEval {
         history: end.encode(),
@@ -1181,7 +1173,7 @@ fn rcc_step(bond0: BondState, dt: f64, area: f64, a: &RccParams, x: Vec3) -> (Bo
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AdhesiveResponse {
     /// The point history the step leads to at this x (for RCC: β₁, the bond stretch to
-    /// commit, u_t0 + x_t while bonded and else 0, and D).
+    /// commit, u_t0 + x_t while bonded and else 0, and D as at the start).
     pub history: PointHistory,
     /// Adhesive force r̃ [N] in the local frame.
     pub force: Vec3,

@@ -198,19 +198,18 @@ impl Interface for Rcc {
         .encode()
     }
 
-    /// β₁ and u_t as the step left them, u_t turned to global axes; D as the adhesive
-    /// evaluation accumulated it (§5.4), or kept from the start without adhesion (the point's
-    /// solution then carries no history of its own).
+    /// β₁ and u_t as the step left them, u_t turned to global axes; D accumulated over the
+    /// step's β₀ → β₁ (§5.4), or kept from the start without adhesion.
     fn commit(
         &self,
         start: &PointHistory,
         sol: &PointSolution,
         frame: &[[f64; 3]; 3],
     ) -> NodeHistory {
-        let end = BondState::decode(&sol.history);
+        let (start, end) = (BondState::decode(start), BondState::decode(&sol.history));
         let damage = match &self.0 {
-            Some(_) => end.damage,
-            None => BondState::decode(start).damage,
+            Some(a) => accumulated_damage(start.damage, start.beta, end.beta, a),
+            None => start.damage,
         };
         // The same sums as a frame's rotation of (u_t1, u_t2, 0), to the bit.
         let ut = std::array::from_fn(|k| {
