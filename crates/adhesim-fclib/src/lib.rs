@@ -17,7 +17,7 @@
 use std::path::{Path, PathBuf};
 
 use adhesim::contact::reduced::{BlockSparseDelassus, ReducedSolution};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 
 /// A failure to read an fclib file: the file, the dataset and what went wrong.
 #[derive(Debug, thiserror::Error)]
@@ -413,48 +413,92 @@ impl ReducedProblem {
     }
 
     /// The global problem condensed on the contacts as Siconos does:
-    /// W = Hᵀ M⁻¹ H, q = Hᵀ M⁻¹ f + w, by a dense Cholesky factorisation of M (a diagonal M is
-    /// inverted entry by entry). Exact zeros of W (contacts on bodies that do not interact)
-    /// are not stored. Fails if M is not positive definite.
+    /// W = Hᵀ M⁻¹ H, q = Hᵀ M⁻¹ f + w.
+    ///
+    /// M is split into its diagonal blocks, the connected components of its pattern (one per
+    /// rigid body, one per degree of freedom of a diagonal M, one for a deformable body), each
+    /// factorised dense by Cholesky; then W = Σ_b H_bᵀ M_b⁻¹ H_b over the blocks b, H_b the rows
+    /// of H in block b restricted to the contacts that touch it. The cost is that of the blocks
+    /// and of the contact pairs that share a block, never of an n × n or n × 3n_c dense matrix.
+    /// A file may store M's two triangles or one: an off-diagonal entry whose mirror is absent
+    /// is mirrored. Exact zeros of W (contacts on bodies that do not interact) are not stored.
+    /// Fails, naming the block's first row, if a block of M is not positive definite.
     pub fn condense(p: &GlobalProblem) -> Result<Self, String> {
         let n = p.m.rows;
         let nc3 = p.h.cols;
-        let h = p.h.to_dense();
-        let (minv_h, minv_f) = if p.m.is_diagonal() {
-            let mut d: DVector<f64> = DVector::zeros(n);
-            for &(i, _, v) in &p.m.entries {
-                d[i] += v;
-            }
-            if let Some(k) = d.iter().position(|&v| v <= 0.0 || !v.is_finite()) {
-                return Err(format!("M[{k},{k}] = {} is not positive", d[k]));
-            }
-            let mut z = h.clone();
-            for (i, mut row) in z.row_iter_mut().enumerate() {
-                row /= d[i];
-            }
-            let f = DVector::from_iterator(n, p.f.iter().zip(d.iter()).map(|(f, d)| f / d));
-            (z, f)
-        } else {
-            let chol =
-                p.m.to_dense()
-                    .cholesky()
-                    .ok_or("M is not positive definite")?;
-            (
-                chol.solve(&h),
-                chol.solve(&DVector::from_column_slice(&p.f)),
-            )
-        };
-        let w_dense = h.transpose() * &minv_h;
-        let q = h.transpose() * minv_f + DVector::from_column_slice(&p.w);
+        let blocks = diagonal_blocks(&p.m);
+        let mut h_rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
+        for &(i, j, v) in &p.h.entries {
+            h_rows[i].push((j, v));
+        }
         let perm = |k: usize| 3 * (k / 3) + to_adhesim(k % 3);
-        let entries = (0..nc3)
-            .flat_map(|i| (0..nc3).map(move |j| (i, j)))
-            .filter(|&(i, j)| w_dense[(i, j)] != 0.0)
-            .map(|(i, j)| (perm(i), perm(j), 0.5 * (w_dense[(i, j)] + w_dense[(j, i)])));
+        let mut q = p.w.clone();
+        let mut entries: Vec<(usize, usize, f64)> = Vec::new();
+        // Column of H → its position among the block's columns (usize::MAX: not in the block).
+        let mut slot = vec![usize::MAX; nc3];
+        for block in &blocks {
+            let rows = &block.rows;
+            if let (&[i], Some(DenseCholesky::Scalar(d))) = (rows.as_slice(), &block.chol) {
+                // A 1 × 1 block (a diagonal M): h_i h_iᵀ / d and h_i f_i / d, no dense algebra.
+                for &(a, ha) in &h_rows[i] {
+                    q[a] += ha * p.f[i] / d;
+                    for &(b, hb) in &h_rows[i] {
+                        let v = ha * hb / d;
+                        if v != 0.0 {
+                            entries.push((perm(a), perm(b), v));
+                        }
+                    }
+                }
+                continue;
+            }
+            let mut cols: Vec<usize> = Vec::new();
+            for &i in rows {
+                for &(j, _) in &h_rows[i] {
+                    if slot[j] == usize::MAX {
+                        slot[j] = cols.len();
+                        cols.push(j);
+                    }
+                }
+            }
+            // [H_b | f_b], solved in place by M_b⁻¹.
+            let k = cols.len();
+            let mut hb = DMatrix::<f64>::zeros(rows.len(), k + 1);
+            for (a, &i) in rows.iter().enumerate() {
+                for &(j, v) in &h_rows[i] {
+                    hb[(a, slot[j])] += v;
+                }
+                hb[(a, k)] = p.f[i];
+            }
+            let z = block
+                .chol
+                .as_ref()
+                .ok_or_else(|| {
+                    format!(
+                        "M is not positive definite: its diagonal block of {} row(s) from row {} \
+                         has no Cholesky factor",
+                        rows.len(),
+                        rows[0]
+                    )
+                })?
+                .solve(&hb);
+            let g = hb.columns(0, k).transpose() * &z;
+            for a in 0..k {
+                q[cols[a]] += g[(a, k)];
+                for b in 0..k {
+                    let v = 0.5 * (g[(a, b)] + g[(b, a)]);
+                    if v != 0.0 {
+                        entries.push((perm(cols[a]), perm(cols[b]), v));
+                    }
+                }
+            }
+            for &j in &cols {
+                slot[j] = usize::MAX;
+            }
+        }
         let w = BlockSparseDelassus::from_entries(p.mu.len(), entries);
         Ok(Self {
             w,
-            q: triples_to_adhesim(q.as_slice()),
+            q: triples_to_adhesim(&q),
             mu: p.mu.clone(),
         })
     }
@@ -483,6 +527,104 @@ impl ReducedProblem {
         }
         w
     }
+}
+
+/// A diagonal block of M: its rows (a connected component of M's pattern, in increasing
+/// order) and the Cholesky factor of the block (none if it is not positive definite).
+struct DiagonalBlock {
+    rows: Vec<usize>,
+    chol: Option<DenseCholesky>,
+}
+
+/// Cholesky factor of a small dense symmetric positive definite matrix (1 × 1 blocks, the
+/// rows of a diagonal M, skip nalgebra's general path).
+enum DenseCholesky {
+    Scalar(f64),
+    Dense(nalgebra::Cholesky<f64, nalgebra::Dyn>),
+}
+
+impl DenseCholesky {
+    fn new(a: DMatrix<f64>) -> Option<Self> {
+        if a.nrows() == 1 {
+            let d = a[(0, 0)];
+            return (d > 0.0 && d.is_finite()).then_some(Self::Scalar(d));
+        }
+        a.cholesky().map(Self::Dense)
+    }
+
+    fn solve(&self, b: &DMatrix<f64>) -> DMatrix<f64> {
+        match self {
+            Self::Scalar(d) => b / *d,
+            Self::Dense(c) => c.solve(b),
+        }
+    }
+}
+
+/// M split into its diagonal blocks (the connected components of its pattern), each
+/// symmetrised and factorised.
+fn diagonal_blocks(m: &SparseMatrix) -> Vec<DiagonalBlock> {
+    let n = m.rows;
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    for &(i, j, v) in &m.entries {
+        if v != 0.0 {
+            let (a, b) = (root(&mut parent, i), root(&mut parent, j));
+            if a != b {
+                parent[a.max(b)] = a.min(b);
+            }
+        }
+    }
+    let mut block_of = vec![usize::MAX; n];
+    let mut local = vec![0usize; n];
+    let mut rows: Vec<Vec<usize>> = Vec::new();
+    for i in 0..n {
+        let r = root(&mut parent, i);
+        if block_of[r] == usize::MAX {
+            block_of[r] = rows.len();
+            rows.push(Vec::new());
+        }
+        let b = block_of[r];
+        block_of[i] = b;
+        local[i] = rows[b].len();
+        rows[b].push(i);
+    }
+    let mut dense: Vec<DMatrix<f64>> = rows
+        .iter()
+        .map(|r| DMatrix::zeros(r.len(), r.len()))
+        .collect();
+    for &(i, j, v) in &m.entries {
+        dense[block_of[i]][(local[i], local[j])] += v;
+    }
+    rows.into_iter()
+        .zip(dense)
+        .map(|(rows, mut a)| {
+            let k = a.nrows();
+            for x in 0..k {
+                for y in 0..x {
+                    let (lower, upper) = (a[(x, y)], a[(y, x)]);
+                    let v = if lower == 0.0 {
+                        upper
+                    } else if upper == 0.0 {
+                        lower
+                    } else {
+                        0.5 * (lower + upper)
+                    };
+                    a[(x, y)] = v;
+                    a[(y, x)] = v;
+                }
+            }
+            DiagonalBlock {
+                rows,
+                chol: DenseCholesky::new(a),
+            }
+        })
+        .collect()
 }
 
 /// Solves a global problem without condensing it: the semismooth Newton method of

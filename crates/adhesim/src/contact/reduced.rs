@@ -41,31 +41,49 @@ impl BlockSparseDelassus {
         entries: impl IntoIterator<Item = (usize, usize, f64)>,
     ) -> Self {
         let m = 3 * points;
-        let mut keyed: Vec<(usize, usize, usize, usize, f64)> = entries
+        // (block row, block column, 3·a + b, value), the diagonal blocks added so that each
+        // point has its own block to solve with.
+        let keyed: Vec<(usize, usize, usize, f64)> = entries
             .into_iter()
             .map(|(i, j, v)| {
                 assert!(
                     i < m && j < m,
                     "entry ({i}, {j}) outside a {m}×{m} operator"
                 );
-                (i / 3, j / 3, i % 3, j % 3, v)
+                (i / 3, j / 3, 3 * (i % 3) + j % 3, v)
             })
+            .chain((0..points).map(|p| (p, p, 0, 0.0)))
             .collect();
-        // Every diagonal block is stored, so each point has its own block to solve with.
-        keyed.extend((0..points).map(|p| (p, p, 0, 0, 0.0)));
-        keyed.sort_unstable_by_key(|e| (e.0, e.1));
+        // Bucketed by block row (a counting sort), then each row, short, sorted by column.
+        let mut bucket = vec![0usize; points + 1];
+        for e in &keyed {
+            bucket[e.0 + 1] += 1;
+        }
+        for p in 0..points {
+            bucket[p + 1] += bucket[p];
+        }
+        let mut by_row = vec![(0usize, 0usize, 0.0f64); keyed.len()];
+        let mut next = bucket.clone();
+        for (bi, bj, ab, v) in keyed {
+            by_row[next[bi]] = (bj, ab, v);
+            next[bi] += 1;
+        }
         let mut row_start = vec![0; points + 1];
         let mut cols = Vec::new();
         let mut blocks: Vec<M3> = Vec::new();
-        let mut last: Option<(usize, usize)> = None;
-        for (bi, bj, a, b, v) in keyed {
-            if last != Some((bi, bj)) {
-                cols.push(bj);
-                blocks.push([[0.0; 3]; 3]);
-                row_start[bi + 1] += 1;
-                last = Some((bi, bj));
+        for p in 0..points {
+            let row = &mut by_row[bucket[p]..bucket[p + 1]];
+            row.sort_unstable_by_key(|e| e.0);
+            let mut last = None;
+            for &(bj, ab, v) in row.iter() {
+                if last != Some(bj) {
+                    cols.push(bj);
+                    blocks.push([[0.0; 3]; 3]);
+                    row_start[p + 1] += 1;
+                    last = Some(bj);
+                }
+                blocks.last_mut().expect("a block was pushed")[ab / 3][ab % 3] += v;
             }
-            blocks.last_mut().expect("a block was pushed")[a][b] += v;
         }
         for p in 0..points {
             row_start[p + 1] += row_start[p];
