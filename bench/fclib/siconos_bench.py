@@ -114,57 +114,73 @@ GLOBAL_SOLVERS = {
 }
 
 
-def global_problem(path):
-    """The global problem of a file as Siconos's GlobalFrictionContactProblem
-    (M v = q + H r, u = H^T v + b: fclib's f and w)."""
+def int64_csc(a):
+    """A scipy matrix in compressed columns with 64-bit indices, as siconos.numerics takes it."""
+    a = sp.csc_matrix(a)
+    a.indices = a.indices.astype(np.int64)
+    a.indptr = a.indptr.astype(np.int64)
+    return a
+
+
+def read_global(path):
+    """M, H, f, w and mu of a global file."""
     g = h5py.File(path, "r")["fclib_global"]
+    return (int64_csc(sparse(g["M"])), int64_csc(sparse(g["H"])), g["vectors/f"][()],
+            g["vectors/w"][()], g["vectors/mu"][()])
 
-    def numerics(a):
-        a = sp.csc_matrix(a)
-        a.indices = a.indices.astype(np.int64)
-        a.indptr = a.indptr.astype(np.int64)
-        return a
 
+def global_problem(M, H, f, w, mu):
+    """Siconos's GlobalFrictionContactProblem (M v = q + H r, u = H^T v + b: fclib's f, w)."""
     p = sn.GlobalFrictionContactProblem()
     p.dimension = 3
-    mu = g["vectors/mu"][()]
     p.numberOfContacts = len(mu)
-    p.M = numerics(sparse(g["M"]))
-    p.H = numerics(sparse(g["H"]))
-    p.q = g["vectors/f"][()]
-    p.b = g["vectors/w"][()]
-    p.mu = mu
-    return p, sparse(g["M"]).shape[0], 3 * len(mu)
+    p.M, p.H, p.q, p.b, p.mu = M, H, f, w, mu
+    return p
+
+
+def timed_runs(runs, prepare, solve):
+    """Up to `runs` runs (once more only while a run takes less than LONG_RUN), each
+    solve(prepare()) with only solve timed; the last result and each run's time [s]."""
+    times = []
+    for _ in range(runs):
+        args = prepare()
+        t0 = time.perf_counter()
+        solve(*args)
+        times.append(time.perf_counter() - t0)
+        if times[-1] > LONG_RUN:
+            break
+    return args, times
+
+
+def csv_line(path, kind, contacts, solver, converged, err, iters, time_ms, runs, condense_ms=""):
+    """One line of the CSV this script prints."""
+    name = path.rsplit("/", 1)[-1]
+    return (f"{name},{kind},{contacts},{solver},{str(bool(converged)).lower()},{err:.3e},"
+            f"{iters},{time_ms:.4f},{runs},{condense_ms}")
 
 
 def run_global_child(path, solver, tol, runs, max_iter):
     """One global solver on one file, in this (child) process: prints its CSV line."""
     kind, Wc, q, mu, _ = load(path)
-    times = []
-    for _ in range(runs):
+    data = read_global(path)
+    n, m = data[0].shape[0], 3 * len(mu)
+
+    def prepare():
         # A fresh problem for every run: the "_WR" solvers crash (SIGFPE) when a problem is
         # solved a second time.
-        p, n, m = global_problem(path)
         so = sn.SolverOptions(getattr(sn, "SICONOS_GLOBAL_FRICTION_3D_" + GLOBAL_SOLVERS[solver]))
         so.dparam[sn.SICONOS_DPARAM_TOL] = tol
         so.iparam[sn.SICONOS_IPARAM_MAX_ITER] = max_iter
-        r, u, v = np.zeros(m), np.zeros(m), np.zeros(n)
-        t0 = time.perf_counter()
-        sn.gfc3d_driver(p, r, u, v, so)
-        dt = time.perf_counter() - t0
-        times.append(dt)
-        if dt > LONG_RUN:
-            break
+        return global_problem(*data), np.zeros(m), np.zeros(m), np.zeros(n), so
+
+    (_, r, _, _, so), times = timed_runs(runs, prepare, sn.gfc3d_driver)
     err = error(Wc, q, mu, r)
     iters = so.iparam[sn.SICONOS_IPARAM_ITER_DONE]
-    print(
-        f"{path.rsplit('/', 1)[-1]},{kind},{len(mu)},{solver},{str(bool(err <= tol)).lower()},"
-        f"{err:.3e},{iters},{1e3 * float(np.median(times)):.4f},{len(times)},",
-        flush=True,
-    )
+    print(csv_line(path, kind, len(mu), solver, err <= tol, err, iters,
+                   1e3 * float(np.median(times)), len(times)), flush=True)
 
 
-def run_global(path, solver, tol, runs, max_iter, timeout):
+def run_global(path, contacts, solver, tol, runs, max_iter, timeout):
     """A global solver in a child process; a crash or a timeout is a line 'not converged'."""
     args = [sys.executable, __file__, "--tol", str(tol), "--runs", str(runs), "--max-iter",
             str(max_iter), "--global-child", solver, path]
@@ -178,8 +194,7 @@ def run_global(path, solver, tol, runs, max_iter, timeout):
     except subprocess.TimeoutExpired:
         why = f"over {timeout} s"
     print(f"{path}: {solver}: {why}", file=sys.stderr)
-    name = path.rsplit("/", 1)[-1]
-    print(f"{name},global,{len(load(path)[3])},{solver},false,nan,0,{1e3 * timeout:.4f},0,",
+    print(csv_line(path, "global", contacts, solver, False, float("nan"), 0, 1e3 * timeout, 0),
           flush=True)
 
 
@@ -207,36 +222,25 @@ def main(argv):
     for path in files:
         kind, Wc, q, mu, condense_ms = load(path)
         m = Wc.shape[0]
-        Wc.indices = Wc.indices.astype(np.int64)
-        Wc.indptr = Wc.indptr.astype(np.int64)
+        Wc = int64_csc(Wc)
         info, sbm = sn.SBM_from_csparse(3, Wc)
         if info != 0:
             sys.exit(f"{path}: W cannot be stored in 3x3 blocks")
         Wsbm = sn.NM_new_SBM(m, m, sbm)
         problem = sn.FrictionContactProblem(3, Wsbm, q, mu)
-        name = path.rsplit("/", 1)[-1]
+        cm = "" if condense_ms is None else f"{condense_ms:.3f}"
         for solver in SOLVERS:
-            times = []
-            for _ in range(runs):
-                so = options(solver, tol, max_iter)
-                r, u = np.zeros(m), np.zeros(m)
-                t0 = time.perf_counter()
-                sn.fc3d_driver(problem, r, u, so)
-                dt = time.perf_counter() - t0
-                times.append(dt)
-                if dt > LONG_RUN:
-                    break
+            def prepare():
+                return problem, np.zeros(m), np.zeros(m), options(solver, tol, max_iter)
+
+            (_, r, _, so), times = timed_runs(runs, prepare, sn.fc3d_driver)
             err = error(Wc, q, mu, r)
             iters = so.iparam[sn.SICONOS_IPARAM_ITER_DONE]
-            cm = "" if condense_ms is None else f"{condense_ms:.3f}"
-            print(
-                f"{name},{kind},{len(mu)},{solver},{str(bool(err <= tol)).lower()},{err:.3e},"
-                f"{iters},{1e3 * float(np.median(times)):.4f},{len(times)},{cm}",
-                flush=True,
-            )
+            print(csv_line(path, kind, len(mu), solver, err <= tol, err, iters,
+                           1e3 * float(np.median(times)), len(times), cm), flush=True)
         if kind == "global":
             for solver in GLOBAL_SOLVERS:
-                run_global(path, solver, tol, runs, max_iter, timeout)
+                run_global(path, len(mu), solver, tol, runs, max_iter, timeout)
 
 
 if __name__ == "__main__":

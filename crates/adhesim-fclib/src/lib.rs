@@ -131,6 +131,14 @@ impl FclibFile {
             Problem::Global(p) => p.mu.len(),
         }
     }
+
+    /// The global problem, if the file holds one.
+    pub fn global(&self) -> Option<&GlobalProblem> {
+        match &self.problem {
+            Problem::Global(p) => Some(p),
+            Problem::Local(_) => None,
+        }
+    }
 }
 
 struct Reader<'a> {
@@ -375,6 +383,11 @@ pub fn from_adhesim(adhesim_component: usize) -> usize {
     (adhesim_component + 1) % 3
 }
 
+/// Index in adhesim's order of entry `k` = 3·contact + component of an fclib vector.
+pub fn index_to_adhesim(k: usize) -> usize {
+    3 * (k / 3) + to_adhesim(k % 3)
+}
+
 /// A contact-ordered vector of fclib (N, T1, T2) triples as adhesim (t1, t2, n) triples.
 pub fn triples_to_adhesim(v: &[f64]) -> Vec<[f64; 3]> {
     v.chunks_exact(3)
@@ -400,7 +413,7 @@ pub struct ReducedProblem {
 impl ReducedProblem {
     /// The local problem of a file, components permuted to (t1, t2, n).
     pub fn from_local(p: &LocalProblem) -> Self {
-        let perm = |k: usize| 3 * (k / 3) + to_adhesim(k % 3);
+        let perm = index_to_adhesim;
         let w = BlockSparseDelassus::from_entries(
             p.mu.len(),
             p.w.entries.iter().map(|&(i, j, v)| (perm(i), perm(j), v)),
@@ -431,7 +444,7 @@ impl ReducedProblem {
         for &(i, j, v) in &p.h.entries {
             h_rows[i].push((j, v));
         }
-        let perm = |k: usize| 3 * (k / 3) + to_adhesim(k % 3);
+        let perm = index_to_adhesim;
         let mut q = p.w.clone();
         let mut entries: Vec<(usize, usize, f64)> = Vec::new();
         // Column of H → its position among the block's columns (usize::MAX: not in the block).

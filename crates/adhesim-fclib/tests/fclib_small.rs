@@ -5,7 +5,7 @@
 use adhesim::contact::natural_map::{natural_map_residual, relative_error};
 use adhesim::contact::reduced::gauss_seidel_blocks;
 use adhesim::contact::semismooth::semismooth_newton;
-use adhesim_fclib::{read, Problem, ReducedProblem, Storage};
+use adhesim_fclib::{read, ReducedProblem, Storage};
 
 fn data(name: &str) -> String {
     format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"))
@@ -24,9 +24,7 @@ fn close(a: f64, b: f64, tol: f64) -> bool {
 fn condensation_by_blocks_equals_the_dense_one() {
     for name in SMALL_GLOBAL {
         let file = read(data(name)).expect("readable");
-        let Problem::Global(p) = &file.problem else {
-            panic!("{name} is a global problem");
-        };
+        let p = file.global().expect("a global problem");
         let mut m = p.m.to_dense();
         // A file may store one triangle of M: complete it.
         for i in 0..m.nrows() {
@@ -47,7 +45,7 @@ fn condensation_by_blocks_equals_the_dense_one() {
         let red = ReducedProblem::condense(p).expect("condensable");
         let w = red.dense_w();
         let m3 = 3 * p.mu.len();
-        let perm = |k: usize| 3 * (k / 3) + adhesim_fclib::to_adhesim(k % 3);
+        let perm = adhesim_fclib::index_to_adhesim;
         let w_scale = w_ref.amax();
         let q_scale = q_ref.amax();
         for i in 0..m3 {
@@ -72,9 +70,7 @@ fn condensation_by_blocks_equals_the_dense_one() {
 #[test]
 fn reads_lmgc_global_problem() {
     let file = read(data("LMGC_GFC3D-i00501-4-00000.hdf5")).expect("readable");
-    let Problem::Global(p) = &file.problem else {
-        panic!("a global problem expected")
-    };
+    let p = file.global().expect("a global problem");
     // Sizes and storage as h5py lists them: M 162×162 with 6174 triplets, H 162×12 with 288.
     assert_eq!((p.m.rows, p.m.cols, p.m.nnz()), (162, 162, 6174));
     assert_eq!(p.m.storage, Storage::Triplets);
@@ -101,9 +97,7 @@ fn reads_lmgc_global_problem() {
 #[test]
 fn reads_box_stacks_with_guesses() {
     let file = read(data("Box_Stacks-i0122-82-5.hdf5")).expect("readable");
-    let Problem::Global(p) = &file.problem else {
-        panic!("a global problem expected")
-    };
+    let p = file.global().expect("a global problem");
     assert_eq!((p.m.rows, p.m.nnz()), (450, 450));
     assert!(p.m.is_diagonal());
     assert_eq!((p.h.rows, p.h.cols, p.h.nnz()), (450, 246, 1284));
@@ -182,9 +176,7 @@ fn solves_small_problems_to_1e8() {
 fn global_form_solves_the_small_global_problems() {
     for name in SMALL_GLOBAL {
         let file = read(data(name)).expect("readable");
-        let Problem::Global(global) = &file.problem else {
-            panic!("{name} is a global problem");
-        };
+        let global = file.global().expect("a global problem");
         let sol = adhesim_fclib::solve_global(global, 1e-8, 200).expect("solvable");
         assert!(sol.converged, "{name}: error {}", sol.error);
         let p = ReducedProblem::of_file(&file).expect("condensable");

@@ -238,7 +238,7 @@ fn main() -> ExitCode {
             // not in the `condense_ms` column.
             let max_newton = o.max_iter.min(MAX_NEWTON);
             let (sol, times, condensed) = if solver.starts_with("global-") {
-                let Problem::Global(global) = &file.problem else {
+                let Some(global) = file.global() else {
                     continue;
                 };
                 let (sol, times) = timed(o.runs, || {

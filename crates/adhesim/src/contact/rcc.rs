@@ -93,7 +93,7 @@ impl From<&NodeHistory> for RccHistory {
 
 /// The RCC bond law with its parameters, or without (`None`): dry contact, whose nodes keep
 /// the RCC history (β = 0, no stretch, the damage they had).
-#[derive(Clone, Copy, PartialEq)]
+#[derive(Clone, Copy)]
 pub struct Rcc(pub Option<RccParams>);
 
 impl Rcc {
