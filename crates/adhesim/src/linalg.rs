@@ -9,6 +9,7 @@ use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
     SymmetricOrdering,
 };
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side, Spec};
 
@@ -294,6 +295,14 @@ impl LinearSolve for SparseCholesky {
     }
 }
 
+/// faer's choice between its simplicial and supernodal Cholesky factorisations, a multiple
+/// of its default threshold on the factorisation's flops per nonzero of L (supernodal above
+/// 40 × this). Half the default: the README example's one-element-thick slab (9.4k unknowns)
+/// falls between the two, and its 1,663 factorisations took 5.2 to 5.7 s supernodal against
+/// 10.5 to 11.4 s simplicial; the 4.3 plate (2.4k unknowns) 0.91 s against 1.42 s. Bulky 3D
+/// meshes are supernodal either way.
+const SUPERNODAL_THRESHOLD: SupernodalThreshold = SupernodalThreshold(0.5);
+
 /// A sparse Cholesky factorisation whose symbolic part is reused across numeric
 /// factorisations of matrices with the same pattern.
 pub struct SparseCholesky {
@@ -303,8 +312,6 @@ pub struct SparseCholesky {
     mem: MemBuffer,
     /// Threads of the numeric factorisation.
     factorise_par: ParChoice,
-    /// Threads of a solve with a block of right-hand sides.
-    block_par: Par,
     factorised: bool,
 }
 
@@ -404,7 +411,10 @@ impl SparseCholesky {
             sym.as_ref(),
             Side::Upper,
             SymmetricOrdering::Custom(perm),
-            CholeskySymbolicParams::default(),
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: SUPERNODAL_THRESHOLD,
+                ..Default::default()
+            },
         )
         .map_err(|e| LinalgError::Symbolic(format!("{e:?}")))?;
         let threads = if threads == 0 {
@@ -419,7 +429,7 @@ impl SparseCholesky {
         };
         let req = StackReq::any_of(&[
             symbolic.factorize_numeric_llt_scratch::<f64>(par, Spec::default()),
-            symbolic.solve_in_place_scratch::<f64>(64, par),
+            symbolic.solve_in_place_scratch::<f64>(64, Par::Seq),
         ]);
         let mem =
             MemBuffer::try_new(req).map_err(|_| LinalgError::Symbolic("out of memory".into()))?;
@@ -430,7 +440,6 @@ impl SparseCholesky {
             l_values,
             mem,
             factorise_par: ParChoice::new(threads),
-            block_par: par,
             factorised: false,
         })
     }
@@ -447,17 +456,17 @@ impl SparseCholesky {
         let stack = MemStack::new(&mut self.mem);
         let par = self.factorise_par.next();
         let clock = std::time::Instant::now();
-        self.symbolic
-            .factorize_numeric_llt(
-                &mut self.l_values,
-                a,
-                Side::Upper,
-                LltRegularization::default(),
-                par,
-                stack,
-                Spec::default(),
-            )
-            .map_err(|_| LinalgError::NotPositiveDefinite)?;
+        let factorised = self.symbolic.factorize_numeric_llt(
+            &mut self.l_values,
+            a,
+            Side::Upper,
+            LltRegularization::default(),
+            par,
+            stack,
+            Spec::default(),
+        );
+        clear_upper_vector_state(par);
+        factorised.map_err(|_| LinalgError::NotPositiveDefinite)?;
         self.factorise_par
             .record(par, clock.elapsed().as_secs_f64());
         self.factorised = true;
@@ -473,22 +482,20 @@ impl SparseCholesky {
             return;
         }
         let llt = LltRef::new(&self.symbolic, &self.l_values);
-        // One right-hand side (Newton corrections, GMRES's preconditioner) is solved on one
-        // thread: its triangular solves are short and memory-bound, and waking the pool for
-        // each cost the 4.4 twist 45 % more contact-solve time (docs/running.md). Unlike
-        // the factorisation, the parallel solve sums in another order, so the choice is fixed
-        // rather than timed: results must not depend on the machine's load.
-        let par = if rhs.len() == n {
-            Par::Seq
-        } else {
-            self.block_par
-        };
+        // Solved on one thread, one right-hand side (Newton corrections, GMRES's
+        // preconditioner) or many (the columns of W): the triangular solves are short and
+        // memory-bound. Waking the pool for each single one cost the 4.4 twist 45 % more
+        // contact-solve time (docs/running.md), and with 2 threads the blocks of W's columns
+        // took 1.4 to 1.6 times as long as on one (README example and a 484-point pad with
+        // Gauss-Seidel). Unlike the factorisation, a parallel solve sums in another order,
+        // so the choice is not timed: results must not depend on the machine's load.
         for chunk in rhs.chunks_mut(64 * n) {
             let k = chunk.len() / n;
             let mat = MatMut::from_column_major_slice_mut(chunk, n, k);
             let stack = MemStack::new(&mut self.mem);
-            llt.solve_in_place_with_conj(Conj::No, mat, par, stack);
+            llt.solve_in_place_with_conj(Conj::No, mat, Par::Seq, stack);
         }
+        clear_upper_vector_state(Par::Seq);
     }
 
     /// The scalar symbolic pattern (upper triangle).
@@ -939,6 +946,38 @@ mod tests {
         );
         for (xi, ei) in x.iter().zip(exact.iter()) {
             assert!((xi - ei).abs() < 1e-10 * exact.norm(), "{xi} vs {ei}");
+        }
+    }
+}
+
+/// Clears the upper halves of the vector registers on this thread (`vzeroupper`), and on
+/// every thread of the rayon pool when `par` ran work there, after a call into faer.
+///
+/// faer's supernodal kernels run AVX/AVX-512 code (detected at run time) and can return with
+/// the registers' upper halves in use. adhesim itself is compiled for baseline x86-64, with
+/// SSE instructions, and on processors that track that state every SSE instruction then
+/// waits on the upper halves: the element kernels ran twice as slowly after a supernodal
+/// factorisation (the README example's assembly took 28 s instead of 13 s) until this was
+/// called. Without AVX, or on another architecture, it does nothing.
+pub fn clear_upper_vector_state(par: Par) {
+    clear_this_thread();
+    if let Par::Rayon(_) = par {
+        rayon::broadcast(|_| clear_this_thread());
+    }
+}
+
+#[inline]
+fn clear_this_thread() {
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[target_feature(enable = "avx")]
+        unsafe fn zero_upper() {
+            std::arch::x86_64::_mm256_zeroupper();
+        }
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the processor has AVX (checked above), the only requirement of the
+            // instruction.
+            unsafe { zero_upper() }
         }
     }
 }

@@ -21,7 +21,7 @@ use faer::sparse::linalg::SymbolicSupernodalParams;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Spec};
 
-use crate::linalg::LinalgError;
+use crate::linalg::{clear_upper_vector_state, LinalgError};
 
 /// The LU factors of a square sparse matrix with a fixed pattern and column ordering.
 pub struct OrderedLu {
@@ -127,7 +127,8 @@ impl OrderedLu {
         let at = SparseColMatRef::new(self.transposed.as_ref(), &self.transposed_values);
         let perm = PermRef::new_checked(&self.col_fwd, &self.col_inv, self.col_fwd.len());
         let stack = MemStack::new(&mut self.mem);
-        factorize_supernodal_numeric_lu(
+        let par = Par::rayon(0);
+        let factorised = factorize_supernodal_numeric_lu(
             &mut self.row_fwd,
             &mut self.row_inv,
             &mut self.lu,
@@ -135,11 +136,12 @@ impl OrderedLu {
             at,
             perm,
             &self.symbolic,
-            Par::rayon(0),
+            par,
             stack,
             Spec::default(),
-        )
-        .map_err(|_| LinalgError::NotPositiveDefinite)?;
+        );
+        clear_upper_vector_state(par);
+        factorised.map_err(|_| LinalgError::NotPositiveDefinite)?;
         self.factorised = true;
         Ok(())
     }
@@ -159,6 +161,7 @@ impl OrderedLu {
             Par::Seq,
             stack,
         );
+        clear_upper_vector_state(Par::Seq);
     }
 }
 

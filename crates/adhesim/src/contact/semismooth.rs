@@ -35,6 +35,8 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{Argsort, Pair, SparseColMat, SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Spec};
 
+use crate::linalg::clear_upper_vector_state;
+
 use super::law::{
     bipotential_trial, dry_projection, modified_displacement_jacobian, projection_jacobian,
 };
@@ -138,6 +140,7 @@ impl JacobianPattern {
             self.lu
                 .factorize_numeric_lu(&mut self.numeric, a, Par::Seq, stack, Spec::default())
         else {
+            clear_upper_vector_state(Par::Seq);
             return false;
         };
         let n = rhs.len();
@@ -148,6 +151,7 @@ impl JacobianPattern {
             Par::Seq,
             stack,
         );
+        clear_upper_vector_state(Par::Seq);
         true
     }
 }
@@ -204,6 +208,7 @@ fn newton_direction(
         }
         jac.partial_piv_lu()
             .solve_in_place(MatMut::from_column_major_slice_mut(&mut d, 3 * n, 1));
+        clear_upper_vector_state(Par::Seq);
     } else {
         if pattern.is_none() {
             *pattern = JacobianPattern::new(3 * n, &entries);
