@@ -306,7 +306,12 @@ const SUPERNODAL_THRESHOLD: SupernodalThreshold = SupernodalThreshold(0.5);
 /// A sparse Cholesky factorisation whose symbolic part is reused across numeric
 /// factorisations of matrices with the same pattern.
 pub struct SparseCholesky {
+    /// The pattern factorised: the analysed one without its dropped entries.
     pattern: SymbolicSparseColMat<usize>,
+    /// Positions in the analysed pattern's values of the entries kept (empty: all kept).
+    kept: Vec<usize>,
+    /// The kept entries' values, gathered for the factorisation.
+    kept_values: Vec<f64>,
     symbolic: SymbolicCholesky<usize>,
     l_values: Vec<f64>,
     mem: MemBuffer,
@@ -397,15 +402,40 @@ impl SparseCholesky {
     /// Symbolic analysis: METIS ordering and elimination structure. `threads` = 0 uses the
     /// rayon pool's size.
     pub fn analyse(pattern: &BlockPattern, threads: usize) -> Result<Self, LinalgError> {
+        Self::analyse_without(pattern, threads, &[])
+    }
+
+    /// [`Self::analyse`] for matrices whose entries at the positions `dropped` (off-diagonal,
+    /// in increasing order, indices into the pattern's values) are zero in every matrix
+    /// factorised, e.g. the rows and columns of prescribed unknowns. They are left out of the
+    /// ordering and of the factor: a node held in all three directions would otherwise join
+    /// its neighbours in the elimination and fill the factor in as a free one does (a
+    /// quarter of the factor of the scale benchmark's pad, whose top face is held).
+    pub fn analyse_without(
+        pattern: &BlockPattern,
+        threads: usize,
+        dropped: &[usize],
+    ) -> Result<Self, LinalgError> {
         let n = pattern.dim();
-        let sym = SymbolicSparseColMat::new_checked(
-            n,
-            n,
-            pattern.col_ptr.clone(),
-            None,
-            pattern.row_idx.clone(),
-        );
-        let (fwd, inv) = metis_dof_ordering(pattern)?;
+        let pruned = (!dropped.is_empty()).then(|| without_entries(pattern, dropped));
+        let (kept, sym, (fwd, inv)) = match pruned {
+            Some(p) => (
+                p.kept,
+                SymbolicSparseColMat::new_checked(n, n, p.col_ptr, None, p.row_idx),
+                metis_dof_ordering(&p.nodes)?,
+            ),
+            None => (
+                Vec::new(),
+                SymbolicSparseColMat::new_checked(
+                    n,
+                    n,
+                    pattern.col_ptr.clone(),
+                    None,
+                    pattern.row_idx.clone(),
+                ),
+                metis_dof_ordering(pattern)?,
+            ),
+        };
         let perm = faer::perm::PermRef::new_checked(&fwd, &inv, n);
         let symbolic = factorize_symbolic_cholesky(
             sym.as_ref(),
@@ -436,6 +466,8 @@ impl SparseCholesky {
         let l_values = vec![0.0; symbolic.len_val()];
         Ok(SparseCholesky {
             pattern: sym,
+            kept_values: vec![0.0; kept.len()],
+            kept,
             symbolic,
             l_values,
             mem,
@@ -449,9 +481,18 @@ impl SparseCholesky {
         self.symbolic.len_val()
     }
 
-    /// Numeric factorisation of the matrix with this pattern and upper-triangle `values`.
+    /// Numeric factorisation of the matrix with the analysed pattern and upper-triangle
+    /// `values` (those at the dropped positions are not read).
     pub fn factorise(&mut self, values: &[f64]) -> Result<(), LinalgError> {
         self.factorised = false;
+        let values = if self.kept.is_empty() {
+            values
+        } else {
+            for (v, &q) in self.kept_values.iter_mut().zip(&self.kept) {
+                *v = values[q];
+            }
+            &self.kept_values[..]
+        };
         let a = SparseColMatRef::new(self.pattern.as_ref(), values);
         let stack = MemStack::new(&mut self.mem);
         let par = self.factorise_par.next();
@@ -498,9 +539,57 @@ impl SparseCholesky {
         clear_upper_vector_state(Par::Seq);
     }
 
-    /// The scalar symbolic pattern (upper triangle).
+    /// The scalar symbolic pattern factorised (upper triangle, without the dropped entries).
     pub fn pattern(&self) -> SymbolicSparseColMatRef<'_, usize> {
         self.pattern.as_ref()
+    }
+}
+
+/// The scalar pattern of `pattern` without the entries at the positions `dropped`
+/// (increasing).
+struct PrunedPattern {
+    /// Positions in `pattern`'s values of the entries kept.
+    kept: Vec<usize>,
+    /// Column pointers of the kept entries (upper triangle).
+    col_ptr: Vec<usize>,
+    /// Their row indices.
+    row_idx: Vec<usize>,
+    /// The node pattern for the ordering: two nodes are neighbours when an entry between
+    /// them is kept.
+    nodes: BlockPattern,
+}
+
+fn without_entries(pattern: &BlockPattern, dropped: &[usize]) -> PrunedPattern {
+    let n = pattern.dim();
+    let mut kept = Vec::with_capacity(pattern.nnz() - dropped.len());
+    let mut col_ptr = Vec::with_capacity(n + 1);
+    let mut row_idx = Vec::with_capacity(pattern.nnz() - dropped.len());
+    let mut nbrs: Vec<Vec<usize>> = (0..pattern.num_nodes).map(|b| vec![b]).collect();
+    let mut next_dropped = dropped.iter().peekable();
+    col_ptr.push(0);
+    for j in 0..n {
+        for q in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
+            if next_dropped.next_if_eq(&&q).is_some() {
+                continue;
+            }
+            let i = pattern.row_idx[q];
+            kept.push(q);
+            row_idx.push(i);
+            if i / 3 != j / 3 {
+                nbrs[j / 3].push(i / 3);
+            }
+        }
+        col_ptr.push(row_idx.len());
+    }
+    for list in &mut nbrs {
+        list.sort_unstable();
+        list.dedup();
+    }
+    PrunedPattern {
+        kept,
+        col_ptr,
+        row_idx,
+        nodes: BlockPattern::from_neighbours(pattern.num_nodes, nbrs),
     }
 }
 
@@ -821,6 +910,74 @@ mod tests {
                 );
             }
         });
+    }
+
+    /// A factorisation analysed without the rows and columns of held nodes (a face of a
+    /// 6×6×4 grid of hexahedra, every direction held) solves the matrix with those rows and
+    /// columns zero and a unit diagonal as the full analysis does (to 1e-12, round-off of a
+    /// diagonally dominant matrix), with a smaller factor.
+    #[test]
+    fn held_rows_left_out_of_the_analysis_solve_alike() {
+        let (nx, ny, nz) = (7, 7, 5);
+        let id = |i: usize, j: usize, k: usize| i + nx * (j + ny * k);
+        let mut cells = Vec::new();
+        for k in 0..nz - 1 {
+            for j in 0..ny - 1 {
+                for i in 0..nx - 1 {
+                    let mut c = Vec::new();
+                    for (di, dj, dk) in [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)] {
+                        c.push(id(i + di, j + dj, k + dk));
+                    }
+                    for (di, dj, dk) in [(0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)] {
+                        c.push(id(i + di, j + dj, k + dk));
+                    }
+                    cells.push(c);
+                }
+            }
+        }
+        let nodes = nx * ny * nz;
+        let p = BlockPattern::from_cells(nodes, cells.iter().map(|c| &c[..]));
+        let held = |d: usize| d / 3 < nx * ny;
+        let mut values = vec![0.0; p.nnz()];
+        let mut dropped = Vec::new();
+        for j in 0..p.dim() {
+            for q in p.col_ptr[j]..p.col_ptr[j + 1] {
+                let i = p.row_idx[q];
+                values[q] = if i == j {
+                    100.0 + (j % 5) as f64
+                } else if held(i) || held(j) {
+                    dropped.push(q);
+                    0.0
+                } else {
+                    -1.0 + 0.1 * ((i + 2 * j) % 7) as f64
+                };
+            }
+        }
+        let mut full = SparseCholesky::analyse(&p, 1).unwrap();
+        let mut pruned = SparseCholesky::analyse_without(&p, 1, &dropped).unwrap();
+        assert!(
+            pruned.factor_nnz() < full.factor_nnz(),
+            "{} against {}",
+            pruned.factor_nnz(),
+            full.factor_nnz()
+        );
+        full.factorise(&values).unwrap();
+        // The dropped entries are not read: garbage there changes nothing.
+        let mut garbage = values.clone();
+        for &q in &dropped {
+            garbage[q] = 1e30;
+        }
+        pruned.factorise(&garbage).unwrap();
+        let b: Vec<f64> = (0..p.dim()).map(|i| ((i * 37) % 11) as f64 - 5.0).collect();
+        let (mut x_full, mut x_pruned) = (b.clone(), b);
+        full.solve_in_place(&mut x_full);
+        pruned.solve_in_place(&mut x_pruned);
+        let err = x_full
+            .iter()
+            .zip(&x_pruned)
+            .map(|(a, c)| (a - c).abs())
+            .fold(0.0, f64::max);
+        assert!(err < 1e-12, "max difference {err}");
     }
 
     #[test]

@@ -53,13 +53,13 @@ impl SystemMatrix {
         rep: Vec<usize>,
     ) -> Result<Self, LinalgError> {
         let (tied, base_to_tied) = base.condensed(&rep);
-        let chol = SparseCholesky::analyse(&tied, 0)?;
         let fixed: Vec<bool> = constrained
             .iter()
             .enumerate()
             .map(|(d, &c)| c || rep[d / 3] != d / 3)
             .collect();
         let zero_positions = zero_positions(&tied, &fixed);
+        let chol = SparseCholesky::analyse_without(&tied, 0, &zero_positions)?;
         let tied_nodes = (0..rep.len())
             .filter(|&t| rep[t] != t)
             .map(|t| (t, rep[t]))
@@ -95,8 +95,8 @@ impl SystemMatrix {
         }
         let all: Vec<(usize, usize)> = self.couplings.iter().copied().collect();
         let (ext, map) = self.tied.with_extra_pairs(&all);
-        self.chol = SparseCholesky::analyse(&ext, 0)?;
         self.zero_positions = zero_positions(&ext, &self.fixed);
+        self.chol = SparseCholesky::analyse_without(&ext, 0, &self.zero_positions)?;
         self.values = vec![0.0; ext.nnz()];
         self.pattern = ext;
         self.tied_to_ext = Some(map);
