@@ -413,10 +413,11 @@ pub struct ReducedProblem {
 impl ReducedProblem {
     /// The local problem of a file, components permuted to (t1, t2, n).
     pub fn from_local(p: &LocalProblem) -> Self {
-        let perm = index_to_adhesim;
         let w = BlockSparseDelassus::from_entries(
             p.mu.len(),
-            p.w.entries.iter().map(|&(i, j, v)| (perm(i), perm(j), v)),
+            p.w.entries
+                .iter()
+                .map(|&(i, j, v)| (index_to_adhesim(i), index_to_adhesim(j), v)),
         );
         Self {
             w,

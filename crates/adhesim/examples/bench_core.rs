@@ -704,13 +704,7 @@ fn bench_size(cfg: &Config, n: usize) -> SizeResult {
     let metis = time_reps(cfg.reps, || {
         black_box(metis_dof_ordering(pattern).expect("METIS"));
     });
-    let sym = SymbolicSparseColMat::new_checked(
-        dim,
-        dim,
-        pattern.col_ptr.clone(),
-        None,
-        pattern.row_idx.clone(),
-    );
+    let sym = pattern.symbolic();
     let (fwd, inv) = metis_dof_ordering(pattern).expect("METIS");
     let symbolic_samples = time_reps(cfg.reps, || {
         black_box(symbolic_with(&sym, &fwd, &inv));

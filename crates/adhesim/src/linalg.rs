@@ -206,6 +206,12 @@ impl BlockPattern {
         }
     }
 
+    /// The scalar upper pattern as faer's symbolic matrix.
+    pub fn symbolic(&self) -> SymbolicSparseColMat<usize> {
+        let n = self.dim();
+        SymbolicSparseColMat::new_checked(n, n, self.col_ptr.clone(), None, self.row_idx.clone())
+    }
+
     /// The node adjacency graph in CSR form without self loops (for METIS).
     fn node_graph(&self) -> (Vec<i32>, Vec<i32>) {
         let mut full: Vec<Vec<usize>> = vec![Vec::new(); self.num_nodes];
@@ -419,17 +425,9 @@ impl SparseCholesky {
     ) -> Result<Self, LinalgError> {
         let dim = pattern.dim();
         let (reduction, sym, (fwd, inv)) = if dropped.is_empty() {
-            let sym = SymbolicSparseColMat::new_checked(
-                dim,
-                dim,
-                pattern.col_ptr.clone(),
-                None,
-                pattern.row_idx.clone(),
-            );
-            (None, sym, metis_dof_ordering(pattern)?)
+            (None, pattern.symbolic(), metis_dof_ordering(pattern)?)
         } else {
-            let (reduction, sym, nodes) = Reduction::new(pattern, dropped);
-            let ordering = reduction.restrict(metis_dof_ordering(&nodes)?.0);
+            let (reduction, sym, ordering) = Reduction::new(pattern, dropped)?;
             (Some(reduction), sym, ordering)
         };
         let n = sym.nrows();
@@ -490,17 +488,18 @@ impl SparseCholesky {
         let stack = MemStack::new(&mut self.mem);
         let par = self.factorise_par.next();
         let clock = std::time::Instant::now();
-        let factorised = self.symbolic.factorize_numeric_llt(
-            &mut self.l_values,
-            a,
-            Side::Upper,
-            LltRegularization::default(),
-            par,
-            stack,
-            Spec::default(),
-        );
-        clear_upper_vector_state(par);
-        factorised.map_err(|_| LinalgError::NotPositiveDefinite)?;
+        faer_call(par, || {
+            self.symbolic.factorize_numeric_llt(
+                &mut self.l_values,
+                a,
+                Side::Upper,
+                LltRegularization::default(),
+                par,
+                stack,
+                Spec::default(),
+            )
+        })
+        .map_err(|_| LinalgError::NotPositiveDefinite)?;
         self.factorise_par
             .record(par, clock.elapsed().as_secs_f64());
         self.factorised = true;
@@ -514,52 +513,29 @@ impl SparseCholesky {
         if self.dim == 0 {
             return;
         }
-        if let Some(mut r) = self.reduction.take() {
-            // The factorised unknowns gathered, solved, and put back; the others each divided
-            // by its diagonal.
-            let mut compact = std::mem::take(&mut r.compact);
-            compact.clear();
-            for col in rhs.chunks_exact_mut(self.dim) {
-                r.solve_isolated(col);
-                compact.extend(r.free.iter().map(|&i| col[i]));
-            }
-            self.solve_factorised(&mut compact);
-            for (col, part) in rhs
-                .chunks_exact_mut(self.dim)
-                .zip(compact.chunks_exact(r.free.len().max(1)))
-            {
-                for (&i, &v) in r.free.iter().zip(part) {
-                    col[i] = v;
-                }
-            }
-            r.compact = compact;
-            self.reduction = Some(r);
-        } else {
-            self.solve_factorised(rhs);
-        }
-    }
-
-    /// Solves the factorised matrix (the reduced one, if any) in place.
-    fn solve_factorised(&mut self, rhs: &mut [f64]) {
-        let n = self.symbolic.nrows();
-        if n == 0 {
+        let Some(r) = &mut self.reduction else {
+            solve_factorised(&self.symbolic, &self.l_values, &mut self.mem, rhs);
             return;
+        };
+        // The factorised unknowns gathered, solved, and put back; the others each divided by
+        // its diagonal.
+        r.compact.clear();
+        for col in rhs.chunks_exact_mut(self.dim) {
+            r.solve_isolated(col);
+            r.compact.extend(r.free.iter().map(|&i| col[i]));
         }
-        let llt = LltRef::new(&self.symbolic, &self.l_values);
-        // Solved on one thread, one right-hand side (Newton corrections, GMRES's
-        // preconditioner) or many (the columns of W): the triangular solves are short and
-        // memory-bound. Waking the pool for each single one cost the 4.4 twist 45 % more
-        // contact-solve time (docs/running.md), and with 2 threads the blocks of W's columns
-        // took 1.4 to 1.6 times as long as on one (README example and a 484-point pad with
-        // Gauss-Seidel). Unlike the factorisation, a parallel solve sums in another order,
-        // so the choice is not timed: results must not depend on the machine's load.
-        for chunk in rhs.chunks_mut(64 * n) {
-            let k = chunk.len() / n;
-            let mat = MatMut::from_column_major_slice_mut(chunk, n, k);
-            let stack = MemStack::new(&mut self.mem);
-            llt.solve_in_place_with_conj(Conj::No, mat, Par::Seq, stack);
+        solve_factorised(
+            &self.symbolic,
+            &self.l_values,
+            &mut self.mem,
+            &mut r.compact,
+        );
+        let parts = r.compact.chunks_exact(r.free.len().max(1));
+        for (col, part) in rhs.chunks_exact_mut(self.dim).zip(parts) {
+            for (&i, &v) in r.free.iter().zip(part) {
+                col[i] = v;
+            }
         }
-        clear_upper_vector_state(Par::Seq);
     }
 
     /// The scalar symbolic pattern factorised (upper triangle; on the reduction's unknowns
@@ -567,6 +543,38 @@ impl SparseCholesky {
     pub fn pattern(&self) -> SymbolicSparseColMatRef<'_, usize> {
         self.pattern.as_ref()
     }
+}
+
+/// A permutation of the unknowns as (forward, inverse), forward[new] = old.
+type Permutation = (Vec<usize>, Vec<usize>);
+
+/// Solves the factorised matrix (`symbolic`, `l_values`; the reduced one, if any) in place,
+/// for a column-major block of right-hand sides `rhs`, with the scratch space `mem`.
+fn solve_factorised(
+    symbolic: &SymbolicCholesky<usize>,
+    l_values: &[f64],
+    mem: &mut MemBuffer,
+    rhs: &mut [f64],
+) {
+    let n = symbolic.nrows();
+    if n == 0 {
+        return;
+    }
+    let llt = LltRef::new(symbolic, l_values);
+    // Solved on one thread, one right-hand side (Newton corrections, GMRES's preconditioner)
+    // or many (the columns of W): the triangular solves are short and memory-bound. Waking
+    // the pool for each single one cost the 4.4 twist 45 % more contact-solve time
+    // (docs/running.md), and with 2 threads the blocks of W's columns took 1.4 to 1.6 times
+    // as long as on one (README example and a 484-point pad with Gauss-Seidel). Unlike the
+    // factorisation, a parallel solve sums in another order, so the choice is not timed:
+    // results must not depend on the machine's load.
+    faer_call(Par::Seq, || {
+        for chunk in rhs.chunks_mut(64 * n) {
+            let k = chunk.len() / n;
+            let mat = MatMut::from_column_major_slice_mut(chunk, n, k);
+            llt.solve_in_place_with_conj(Conj::No, mat, Par::Seq, MemStack::new(mem));
+        }
+    });
 }
 
 /// The matrix a [`SparseCholesky`] factorises when entries are dropped: the unknowns that
@@ -592,12 +600,13 @@ struct Reduction {
 
 impl Reduction {
     /// The reduction of `pattern` without the entries at the positions `dropped`
-    /// (off-diagonal, increasing), with the pattern factorised (upper triangle) and the node
-    /// pattern for the ordering (two nodes neighbours when an entry between them is kept).
+    /// (off-diagonal, increasing), with the pattern factorised (upper triangle) and its
+    /// ordering (forward, inverse): METIS on the node graph in which two nodes are neighbours
+    /// when an entry between them is kept, restricted to the factorised unknowns.
     fn new(
         pattern: &BlockPattern,
         dropped: &[usize],
-    ) -> (Self, SymbolicSparseColMat<usize>, BlockPattern) {
+    ) -> Result<(Self, SymbolicSparseColMat<usize>, Permutation), LinalgError> {
         let dim = pattern.dim();
         let mut coupled = vec![false; dim];
         let mut keep = vec![true; pattern.nnz()];
@@ -643,6 +652,17 @@ impl Reduction {
             .collect();
         let n = free.len();
         let sym = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        let nodes = BlockPattern::from_neighbours(pattern.num_nodes, nbrs);
+        let fwd: Vec<usize> = metis_dof_ordering(&nodes)?
+            .0
+            .into_iter()
+            .filter(|&old| coupled[old])
+            .map(|old| index[old])
+            .collect();
+        let mut inv = vec![0; n];
+        for (new, &old) in fwd.iter().enumerate() {
+            inv[old] = new;
+        }
         let reduction = Reduction {
             kept_values: vec![0.0; kept.len()],
             isolated_values: vec![0.0; isolated.len()],
@@ -651,30 +671,7 @@ impl Reduction {
             isolated,
             compact: Vec::new(),
         };
-        (
-            reduction,
-            sym,
-            BlockPattern::from_neighbours(pattern.num_nodes, nbrs),
-        )
-    }
-
-    /// The ordering `fwd` of all the unknowns (fwd[new] = old) restricted to the factorised
-    /// ones, numbered among themselves: (forward, inverse).
-    fn restrict(&self, fwd: Vec<usize>) -> (Vec<usize>, Vec<usize>) {
-        let mut index = vec![usize::MAX; fwd.len()];
-        for (k, &i) in self.free.iter().enumerate() {
-            index[i] = k;
-        }
-        let fwd: Vec<usize> = fwd
-            .into_iter()
-            .filter(|&old| index[old] != usize::MAX)
-            .map(|old| index[old])
-            .collect();
-        let mut inv = vec![0; fwd.len()];
-        for (new, &old) in fwd.iter().enumerate() {
-            inv[old] = new;
-        }
-        (fwd, inv)
+        Ok((reduction, sym, (fwd, inv)))
     }
 
     /// The values factorised, from those of the analysed pattern; an isolated unknown whose
@@ -1083,16 +1080,12 @@ mod tests {
         let (mut x_full, mut x_pruned) = (b.clone(), b);
         full.solve_in_place(&mut x_full);
         pruned.solve_in_place(&mut x_pruned);
-        let err = x_full
-            .iter()
-            .zip(&x_pruned)
-            .map(|(a, c)| (a - c).abs())
-            .fold(0.0, f64::max);
+        let err = max_difference(&x_full, &x_pruned);
         assert!(err < 1e-12, "max difference {err}");
         // Every row held: the factorisation is a division by the diagonal.
+        let row_idx = &p.row_idx;
         let every: Vec<usize> = (0..p.dim())
-            .flat_map(|j| p.col_ptr[j]..p.col_ptr[j + 1])
-            .filter(|&q| p.row_idx[q] != q_column(&p, q))
+            .flat_map(|j| (p.col_ptr[j]..p.col_ptr[j + 1]).filter(move |&q| row_idx[q] != j))
             .collect();
         let mut diagonal_only = SparseCholesky::analyse_without(&p, 1, &every).unwrap();
         assert_eq!(diagonal_only.factor_nnz(), 0);
@@ -1105,9 +1098,12 @@ mod tests {
         }
     }
 
-    /// The column of the value at position `q` of `p`.
-    fn q_column(p: &BlockPattern, q: usize) -> usize {
-        p.col_ptr.partition_point(|&start| start <= q) - 1
+    /// The largest entry-wise difference between `a` and `b`.
+    fn max_difference(a: &[f64], b: &[f64]) -> f64 {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max)
     }
 
     #[test]
@@ -1130,11 +1126,7 @@ mod tests {
             );
         }
         chol.solve_in_place(&mut b);
-        let err = b
-            .iter()
-            .zip(&x_true)
-            .map(|(a, t)| (a - t).abs())
-            .fold(0.0, f64::max);
+        let err = max_difference(&b, &x_true);
         assert!(err < 1e-12, "max error {err}");
     }
 
@@ -1237,20 +1229,24 @@ mod tests {
     }
 }
 
-/// Clears the upper halves of the vector registers on this thread (`vzeroupper`), and on
-/// every thread of the rayon pool when `par` ran work there, after a call into faer.
+/// Runs `call`, a call into faer with parallelism `par`, then clears the upper halves of the
+/// vector registers (`vzeroupper`) on this thread and, when `par` ran work on the rayon pool,
+/// on every thread of the pool. Every call into faer's factorisations and solves goes
+/// through it.
 ///
 /// faer's supernodal kernels run AVX/AVX-512 code (detected at run time) and can return with
 /// the registers' upper halves in use. adhesim itself is compiled for baseline x86-64, with
 /// SSE instructions, and on processors that track that state every SSE instruction then
 /// waits on the upper halves: the element kernels ran twice as slowly after a supernodal
-/// factorisation (the README example's assembly took 28 s instead of 13 s) until this was
-/// called. Without AVX, or on another architecture, it does nothing.
-pub fn clear_upper_vector_state(par: Par) {
+/// factorisation (the README example's assembly took 28 s instead of 13 s) until they were
+/// cleared. Without AVX, or on another architecture, clearing does nothing.
+pub fn faer_call<T>(par: Par, call: impl FnOnce() -> T) -> T {
+    let out = call();
     clear_this_thread();
     if let Par::Rayon(_) = par {
         rayon::broadcast(|_| clear_this_thread());
     }
+    out
 }
 
 #[inline]

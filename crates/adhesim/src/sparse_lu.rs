@@ -21,7 +21,7 @@ use faer::sparse::linalg::SymbolicSupernodalParams;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Spec};
 
-use crate::linalg::{clear_upper_vector_state, LinalgError};
+use crate::linalg::{faer_call, LinalgError};
 
 /// The LU factors of a square sparse matrix with a fixed pattern and column ordering.
 pub struct OrderedLu {
@@ -128,20 +128,21 @@ impl OrderedLu {
         let perm = PermRef::new_checked(&self.col_fwd, &self.col_inv, self.col_fwd.len());
         let stack = MemStack::new(&mut self.mem);
         let par = Par::rayon(0);
-        let factorised = factorize_supernodal_numeric_lu(
-            &mut self.row_fwd,
-            &mut self.row_inv,
-            &mut self.lu,
-            a,
-            at,
-            perm,
-            &self.symbolic,
-            par,
-            stack,
-            Spec::default(),
-        );
-        clear_upper_vector_state(par);
-        factorised.map_err(|_| LinalgError::NotPositiveDefinite)?;
+        faer_call(par, || {
+            factorize_supernodal_numeric_lu(
+                &mut self.row_fwd,
+                &mut self.row_inv,
+                &mut self.lu,
+                a,
+                at,
+                perm,
+                &self.symbolic,
+                par,
+                stack,
+                Spec::default(),
+            )
+        })
+        .map_err(|_| LinalgError::NotPositiveDefinite)?;
         self.factorised = true;
         Ok(())
     }
@@ -153,15 +154,16 @@ impl OrderedLu {
         let rows = PermRef::new_checked(&self.row_fwd, &self.row_inv, n);
         let cols = PermRef::new_checked(&self.col_fwd, &self.col_inv, n);
         let stack = MemStack::new(&mut self.mem);
-        self.lu.solve_in_place_with_conj(
-            rows,
-            cols,
-            Conj::No,
-            MatMut::from_column_major_slice_mut(rhs, n, 1),
-            Par::Seq,
-            stack,
-        );
-        clear_upper_vector_state(Par::Seq);
+        faer_call(Par::Seq, || {
+            self.lu.solve_in_place_with_conj(
+                rows,
+                cols,
+                Conj::No,
+                MatMut::from_column_major_slice_mut(rhs, n, 1),
+                Par::Seq,
+                stack,
+            )
+        });
     }
 }
 

@@ -35,7 +35,7 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{Argsort, Pair, SparseColMat, SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Spec};
 
-use crate::linalg::clear_upper_vector_state;
+use crate::linalg::faer_call;
 
 use super::law::{
     bipotential_trial, dry_projection, modified_displacement_jacobian, projection_jacobian,
@@ -135,24 +135,27 @@ impl JacobianPattern {
             return false;
         };
         let a: SparseColMatRef<'_, usize, f64> = jac.as_ref();
-        let stack = MemStack::new(&mut self.mem);
-        let Ok(lu) =
-            self.lu
-                .factorize_numeric_lu(&mut self.numeric, a, Par::Seq, stack, Spec::default())
-        else {
-            clear_upper_vector_state(Par::Seq);
-            return false;
-        };
-        let n = rhs.len();
-        let stack = MemStack::new(&mut self.mem);
-        lu.solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(rhs, n, 1),
-            Par::Seq,
-            stack,
-        );
-        clear_upper_vector_state(Par::Seq);
-        true
+        faer_call(Par::Seq, || {
+            let stack = MemStack::new(&mut self.mem);
+            let Ok(lu) = self.lu.factorize_numeric_lu(
+                &mut self.numeric,
+                a,
+                Par::Seq,
+                stack,
+                Spec::default(),
+            ) else {
+                return false;
+            };
+            let n = rhs.len();
+            let stack = MemStack::new(&mut self.mem);
+            lu.solve_in_place_with_conj(
+                Conj::No,
+                MatMut::from_column_major_slice_mut(rhs, n, 1),
+                Par::Seq,
+                stack,
+            );
+            true
+        })
     }
 }
 
@@ -206,9 +209,10 @@ fn newton_direction(
         for (e, v) in entries.iter().zip(&values) {
             jac[(e.row, e.col)] += v;
         }
-        jac.partial_piv_lu()
-            .solve_in_place(MatMut::from_column_major_slice_mut(&mut d, 3 * n, 1));
-        clear_upper_vector_state(Par::Seq);
+        faer_call(Par::Seq, || {
+            jac.partial_piv_lu()
+                .solve_in_place(MatMut::from_column_major_slice_mut(&mut d, 3 * n, 1))
+        });
     } else {
         if pattern.is_none() {
             *pattern = JacobianPattern::new(3 * n, &entries);
