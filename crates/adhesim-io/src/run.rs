@@ -14,8 +14,10 @@
 
 use crate::checkpoint::{fingerprint, Checkpoint, CheckpointError};
 use crate::output::plot::PlotError;
-use crate::output::{resume_observers, start_observers, Observer, SavedObserver, StepView};
+use crate::output::settings::OutputSettings;
+use crate::output::{observers, Begin, Observer, SavedObserver, StepView};
 use crate::scenario::Scenario;
+use adhesim::problem::Problem;
 use adhesim::time::{SetupError, StepReport, Stepper};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -175,30 +177,70 @@ pub fn run_with(
     control: &RunControl,
 ) -> Result<RunSummary, RunError> {
     let Scenario { problem, output } = scenario;
-    let start = Instant::now();
-    let io_err = |source| RunError::Io {
-        dir: out_dir.to_path_buf(),
-        source,
-    };
+    let started = Instant::now();
     // Held until the run returns; the operating system releases it if the process dies.
-    let _lock = if control.resume && !out_dir.is_dir() {
-        None // nothing to resume: reading the checkpoint below says so
-    } else {
-        Some(crate::outdir::lock(out_dir)?)
-    };
+    let _lock = lock_out_dir(out_dir, control)?;
     let fingerprint = fingerprint(&problem, &output);
-    let resume_from = if control.resume {
+    let checkpoint = open_out_dir(out_dir, control, fingerprint)?;
+    let problem = Arc::new(problem);
+    let stepper = Stepper::new(problem.clone())?;
+    let summary = new_summary(&stepper, scenario_file);
+    let mut run = ActiveRun {
+        out_dir,
+        problem,
+        output,
+        stepper,
+        observers: Vec::new(),
+        summary,
+        fingerprint,
+        started,
+        wall_before: 0.0,
+    };
+    match checkpoint {
+        Some(c) => run.resume_from(c)?,
+        None => run.begin_new()?,
+    }
+    run.update_summary();
+    run.write_summary()?;
+    let result = run.advance(progress, control);
+    run.finish(result, progress)
+}
+
+/// The lock on `out_dir` for the run, none when there is nothing to resume there (reading
+/// the checkpoint then says so).
+fn lock_out_dir(
+    out_dir: &Path,
+    control: &RunControl,
+) -> Result<Option<crate::outdir::DirLock>, RunError> {
+    if control.resume && !out_dir.is_dir() {
+        Ok(None)
+    } else {
+        Ok(Some(crate::outdir::lock(out_dir)?))
+    }
+}
+
+/// The checkpoint to resume from, checked against the problem's `fingerprint`; for a new run,
+/// `out_dir` created and cleared of a previous run (when `control` allows it).
+fn open_out_dir(
+    out_dir: &Path,
+    control: &RunControl,
+    fingerprint: u64,
+) -> Result<Option<Checkpoint>, RunError> {
+    if control.resume {
         let c = Checkpoint::read(out_dir)?;
         c.check_matches(fingerprint, out_dir)?;
-        Some(c)
+        Ok(Some(c))
     } else {
-        std::fs::create_dir_all(out_dir).map_err(io_err)?;
+        std::fs::create_dir_all(out_dir).map_err(|source| io_error(out_dir, source))?;
         crate::outdir::prepare_fresh(out_dir, !control.refuse_existing_run)?;
-        None
-    };
-    let problem = Arc::new(problem);
-    let mut stepper = Stepper::new(problem.clone())?;
-    let mut summary = RunSummary {
+        Ok(None)
+    }
+}
+
+/// The summary of a run of `stepper`'s problem at its start.
+fn new_summary(stepper: &Stepper, scenario_file: Option<&Path>) -> RunSummary {
+    let problem = &stepper.problem;
+    RunSummary {
         name: problem.name.clone(),
         scenario: scenario_file.map(Path::to_path_buf),
         version: env!("CARGO_PKG_VERSION").to_string(),
@@ -214,154 +256,213 @@ pub fn run_with(
         wall_time: 0.0,
         resumed_from: None,
         checkpoint: None,
-    };
-    let mut wall_before = 0.0;
-    let mut observers = match resume_from {
-        Some(c) => {
-            let at = CheckpointInfo {
-                step: c.snapshot.step,
-                t: c.snapshot.t,
-            };
-            stepper
-                .restore(c.snapshot)
-                .map_err(|reason| CheckpointError::Mismatch {
-                    path: Checkpoint::path(out_dir),
-                    reason,
-                })?;
-            summary.steps = at.step;
-            summary.cutbacks = c.cutbacks;
-            summary.newton_iterations = c.newton_iterations;
-            summary.resumed_from = Some(at);
-            summary.checkpoint = Some(at);
-            wall_before = c.wall_time;
-            // Half-written files of the interrupted process.
-            for d in [out_dir.to_path_buf(), out_dir.join("vtu")] {
-                if d.is_dir() {
-                    crate::output::atomic::remove_stale_temps(&d).map_err(io_err)?;
+    }
+}
+
+/// An output-folder error as a [`RunError`].
+fn io_error(out_dir: &Path, source: std::io::Error) -> RunError {
+    RunError::Io {
+        dir: out_dir.to_path_buf(),
+        source,
+    }
+}
+
+/// A run under way: its stepper, its observers and the summary they keep up to date.
+struct ActiveRun<'a> {
+    out_dir: &'a Path,
+    problem: Arc<Problem>,
+    output: OutputSettings,
+    stepper: Stepper,
+    observers: Vec<Box<dyn Observer>>,
+    summary: RunSummary,
+    fingerprint: u64,
+    /// When this process started the run.
+    started: Instant,
+    /// Wall-clock time of the sessions before a resume [s].
+    wall_before: f64,
+}
+
+impl<'a> ActiveRun<'a> {
+    /// A new run: the observers created and handed the state at t = 0.
+    fn begin_new(&mut self) -> Result<(), RunError> {
+        self.observers = observers(self.out_dir, &self.problem, &self.output, Begin::New)
+            .map_err(|source| io_error(self.out_dir, source))?;
+        let initial = StepReport {
+            internal: 0.0,
+            kinetic: self.stepper.kinetic_energy(&self.stepper.state.v),
+            ..Default::default()
+        };
+        self.observe(&initial)
+    }
+
+    /// Goes on from the checkpoint `c`: the stepper restored, the summary's counts taken
+    /// over, half-written files of the interrupted process removed, the observers resumed.
+    fn resume_from(&mut self, c: Checkpoint) -> Result<(), RunError> {
+        let out_dir = self.out_dir;
+        let at = CheckpointInfo {
+            step: c.snapshot.step,
+            t: c.snapshot.t,
+        };
+        self.stepper
+            .restore(c.snapshot)
+            .map_err(|reason| CheckpointError::Mismatch {
+                path: Checkpoint::path(out_dir),
+                reason,
+            })?;
+        let summary = &mut self.summary;
+        summary.steps = at.step;
+        summary.cutbacks = c.cutbacks;
+        summary.newton_iterations = c.newton_iterations;
+        summary.resumed_from = Some(at);
+        summary.checkpoint = Some(at);
+        self.wall_before = c.wall_time;
+        for d in [out_dir.to_path_buf(), out_dir.join("vtu")] {
+            if d.is_dir() {
+                crate::output::atomic::remove_stale_temps(&d)
+                    .map_err(|source| io_error(out_dir, source))?;
+            }
+        }
+        let begin = Begin::Resume {
+            saved: &c.observers,
+            t: at.t,
+        };
+        self.observers = observers(out_dir, &self.problem, &self.output, begin)
+            .map_err(|source| io_error(out_dir, source))?;
+        Ok(())
+    }
+
+    /// Steps until the end time, a stop request (checkpoint written) or a step that fails
+    /// (the outcome says why); an error only when an output or checkpoint cannot be written.
+    fn advance(
+        &mut self,
+        progress: &mut dyn Progress,
+        control: &RunControl,
+    ) -> Result<(), RunError> {
+        while !self.stepper.finished() {
+            if control.stop_requested(self.stepper.state.step) {
+                self.summary.outcome = Outcome::Interrupted;
+                if self.summary.checkpoint.map(|c| c.step) != Some(self.stepper.state.step) {
+                    self.save_checkpoint()?;
+                }
+                return Ok(());
+            }
+            match self.stepper.step() {
+                Ok(report) => self.commit(&report, progress, control.checkpoint_every)?,
+                Err(e) => {
+                    let message = adhesim::diagnosis::describe_step_failure(&self.problem, &e);
+                    progress.message(&message);
+                    self.summary.outcome = Outcome::Failed(message);
+                    return Ok(());
                 }
             }
-            resume_observers(out_dir, &problem, &output, &c.observers, at.t).map_err(io_err)?
         }
-        None => {
-            let mut observers = start_observers(out_dir, &problem, &output).map_err(io_err)?;
-            let initial = StepReport {
-                internal: 0.0,
-                kinetic: stepper.kinetic_energy(&stepper.state.v),
-                ..Default::default()
-            };
-            let view = StepView {
-                problem: &problem,
-                disc: &stepper.disc,
-                state: &stepper.state,
-                report: &initial,
-                contact: &stepper.contact,
-                reactions: stepper.reactions(),
-            };
-            observe(&mut observers, &view).map_err(io_err)?;
-            observers
+        self.summary.outcome = Outcome::Finished;
+        // A finished run has nothing to resume: its last periodic checkpoint goes.
+        match std::fs::remove_file(Checkpoint::path(self.out_dir)) {
+            Ok(()) => self.summary.checkpoint = None,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(io_error(self.out_dir, e)),
         }
-    };
-    let update = |summary: &mut RunSummary, stepper: &Stepper, observers: &[Box<dyn Observer>]| {
-        summary.t_reached = stepper.state.t;
-        summary.frames = observers.iter().map(|o| o.frames_written()).sum();
-        summary.wall_time = wall_before + start.elapsed().as_secs_f64();
-    };
-    update(&mut summary, &stepper, &observers);
-    write_summary(out_dir, &summary).map_err(io_err)?;
-    let save = |summary: &mut RunSummary,
-                stepper: &Stepper,
-                observers: &[Box<dyn Observer>]|
-     -> Result<(), RunError> {
-        update(summary, stepper, observers);
+        Ok(())
+    }
+
+    /// A committed step: counted, observed, reported, and checkpointed every `every` steps
+    /// (0: never) unless it is the last.
+    fn commit(
+        &mut self,
+        report: &StepReport,
+        progress: &mut dyn Progress,
+        every: usize,
+    ) -> Result<(), RunError> {
+        self.summary.steps += 1;
+        self.summary.cutbacks += report.cutbacks;
+        self.summary.newton_iterations += report.newton_iterations;
+        self.observe(report)?;
+        progress.step(report, self.problem.time.t_end);
+        if every > 0 && self.stepper.state.step % every == 0 && !self.stepper.finished() {
+            self.save_checkpoint()?;
+        }
+        Ok(())
+    }
+
+    /// Hands the stepper's current state with `report` to every observer.
+    fn observe(&mut self, report: &StepReport) -> Result<(), RunError> {
+        let view = StepView {
+            problem: &self.problem,
+            disc: &self.stepper.disc,
+            state: &self.stepper.state,
+            report,
+            contact: &self.stepper.contact,
+            reactions: self.stepper.reactions(),
+        };
+        observe(&mut self.observers, &view).map_err(|source| io_error(self.out_dir, source))
+    }
+
+    /// The summary's time reached, frame count and wall time brought up to date.
+    fn update_summary(&mut self) {
+        self.summary.t_reached = self.stepper.state.t;
+        self.summary.frames = self.observers.iter().map(|o| o.frames_written()).sum();
+        self.summary.wall_time = self.wall_before + self.started.elapsed().as_secs_f64();
+    }
+
+    fn write_summary(&self) -> Result<(), RunError> {
+        write_summary(self.out_dir, &self.summary).map_err(|source| io_error(self.out_dir, source))
+    }
+
+    /// Writes a checkpoint of the stepper and the observers, then run.json naming it.
+    fn save_checkpoint(&mut self) -> Result<(), RunError> {
+        self.update_summary();
         let c = Checkpoint {
-            version: summary.version.clone(),
-            fingerprint,
+            version: self.summary.version.clone(),
+            fingerprint: self.fingerprint,
             format: crate::checkpoint::FORMAT,
-            snapshot: stepper.snapshot(),
-            observers: observers
+            snapshot: self.stepper.snapshot(),
+            observers: self
+                .observers
                 .iter()
                 .map(|o| SavedObserver {
                     key: o.key().to_string(),
                     state: o.resume_state(),
                 })
                 .collect(),
-            cutbacks: summary.cutbacks,
-            newton_iterations: summary.newton_iterations,
-            wall_time: summary.wall_time,
+            cutbacks: self.summary.cutbacks,
+            newton_iterations: self.summary.newton_iterations,
+            wall_time: self.summary.wall_time,
         };
-        c.write(out_dir)?;
-        summary.checkpoint = Some(CheckpointInfo {
-            step: stepper.state.step,
-            t: stepper.state.t,
+        c.write(self.out_dir)?;
+        self.summary.checkpoint = Some(CheckpointInfo {
+            step: self.stepper.state.step,
+            t: self.stepper.state.t,
         });
-        write_summary(out_dir, summary).map_err(|source| RunError::Io {
-            dir: out_dir.to_path_buf(),
-            source,
-        })
-    };
-    let result = (|| -> Result<(), RunError> {
-        while !stepper.finished() {
-            if control.stop_requested(stepper.state.step) {
-                summary.outcome = Outcome::Interrupted;
-                if summary.checkpoint.map(|c| c.step) != Some(stepper.state.step) {
-                    save(&mut summary, &stepper, &observers)?;
-                }
-                return Ok(());
-            }
-            match stepper.step() {
-                Ok(report) => {
-                    summary.steps += 1;
-                    summary.cutbacks += report.cutbacks;
-                    summary.newton_iterations += report.newton_iterations;
-                    let view = StepView {
-                        problem: &problem,
-                        disc: &stepper.disc,
-                        state: &stepper.state,
-                        report: &report,
-                        contact: &stepper.contact,
-                        reactions: stepper.reactions(),
-                    };
-                    observe(&mut observers, &view).map_err(io_err)?;
-                    progress.step(&report, problem.time.t_end);
-                    let every = control.checkpoint_every;
-                    if every > 0 && stepper.state.step % every == 0 && !stepper.finished() {
-                        save(&mut summary, &stepper, &observers)?;
-                    }
-                }
-                Err(e) => {
-                    let message = adhesim::diagnosis::describe_step_failure(&problem, &e);
-                    progress.message(&message);
-                    summary.outcome = Outcome::Failed(message);
-                    return Ok(());
-                }
+        self.write_summary()
+    }
+
+    /// Ends the run after [`ActiveRun::advance`] returned `result`: the figures drawn (unless
+    /// it was interrupted or could not write), run.json written with the outcome, and an
+    /// output error handed on after run.json says why the run stopped.
+    fn finish(
+        mut self,
+        result: Result<(), RunError>,
+        progress: &mut dyn Progress,
+    ) -> Result<RunSummary, RunError> {
+        if result.is_ok() && self.output.figures && self.summary.outcome != Outcome::Interrupted {
+            // Figures are a convenience drawn from the files just written: a failure to draw
+            // them is reported, and does not change how the run ended.
+            if let Err(e) = draw_figures(self.out_dir) {
+                progress.message(&format!("figures not drawn: {e}"));
             }
         }
-        summary.outcome = Outcome::Finished;
-        // A finished run has nothing to resume: its last periodic checkpoint goes.
-        match std::fs::remove_file(Checkpoint::path(out_dir)) {
-            Ok(()) => summary.checkpoint = None,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-            Err(e) => return Err(io_err(e)),
+        self.update_summary();
+        if let Err(e) = result {
+            // Leave a run.json that says why the run stopped (best effort: the error may well
+            // be that nothing can be written).
+            self.summary.outcome = Outcome::Failed(e.to_string());
+            let _ = self.write_summary();
+            return Err(e);
         }
-        Ok(())
-    })();
-    if result.is_ok() && output.figures && summary.outcome != Outcome::Interrupted {
-        // Figures are a convenience drawn from the files just written: a failure to draw
-        // them is reported, and does not change how the run ended.
-        if let Err(e) = draw_figures(out_dir) {
-            progress.message(&format!("figures not drawn: {e}"));
-        }
+        self.write_summary()?;
+        Ok(self.summary)
     }
-    update(&mut summary, &stepper, &observers);
-    if let Err(e) = result {
-        // Leave a run.json that says why the run stopped (best effort: the error may well be
-        // that nothing can be written).
-        summary.outcome = Outcome::Failed(e.to_string());
-        let _ = write_summary(out_dir, &summary);
-        return Err(e);
-    }
-    write_summary(out_dir, &summary).map_err(io_err)?;
-    Ok(summary)
 }
 
 /// Hands `view` to every observer, in order.

@@ -11,13 +11,15 @@
 use super::csv::read_history;
 use super::plot::{draw_scalar_map_with, ColorMap, PlotError, ScalarMap, ScalarValues};
 use super::{
-    bad_state, contact_node_fields, contact_node_values, Observer, StepView, CONTACT_NODE_FIELDS,
-    MAPS_KEY,
+    bad_state, contact_node_fields, contact_node_values, saved_state, Begin, Observer, RunObserver,
+    StepView, CONTACT_NODE_FIELDS, MAPS_KEY,
 };
 use crate::codec::{decode_with, encode_with, Codec};
 use crate::output::settings::MapRequest;
+use crate::output::settings::OutputSettings;
 use adhesim::contact::history::{self, FieldKind, HistoryField};
 use adhesim::contact::Interface;
+use adhesim::problem::Problem;
 use std::collections::BTreeMap;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -60,6 +62,22 @@ pub struct MapObserver {
     /// Next time index per request.
     next: Vec<usize>,
     faces_written: Vec<bool>,
+}
+
+impl RunObserver for MapObserver {
+    fn begin(
+        dir: &Path,
+        _problem: &Problem,
+        output: &OutputSettings,
+        begin: Begin,
+    ) -> io::Result<Self> {
+        match begin {
+            Begin::New => MapObserver::new(dir, &output.maps),
+            Begin::Resume { saved, t } => {
+                MapObserver::resume(dir, &output.maps, saved_state(saved, MAPS_KEY), t)
+            }
+        }
+    }
 }
 
 impl MapObserver {

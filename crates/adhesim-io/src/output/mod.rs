@@ -79,62 +79,81 @@ pub const HISTORY_KEY: &str = "history";
 /// Key of the [`maps::MapObserver`].
 pub const MAPS_KEY: &str = "maps";
 
-/// The observers of a new run in `dir`: the VTU frames, history.csv and the contact maps,
-/// each with its files created.
-pub fn start_observers(
-    dir: &Path,
-    problem: &Problem,
-    output: &OutputSettings,
-) -> io::Result<Vec<Box<dyn Observer>>> {
-    Ok(vec![
-        Box::new(FrameWriter::new(dir, &problem.name, output.frame_interval)?),
-        Box::new(HistoryObserver::new(
-            &dir.join("history.csv"),
-            problem,
-            output,
-        )?),
-        Box::new(maps::MapObserver::new(dir, &output.maps)?),
-    ])
+/// How a run's observers begin.
+#[derive(Clone, Copy, Debug)]
+pub enum Begin<'a> {
+    /// A new run: each observer creates its files.
+    New,
+    /// Going on from the states `saved` of a checkpoint taken at time `t` [s].
+    Resume {
+        /// The observers' states in the checkpoint.
+        saved: &'a [SavedObserver],
+        /// Simulated time of the checkpoint [s].
+        t: f64,
+    },
 }
 
-/// The observers of [`start_observers`] going on in `dir` from the states `saved` of a
-/// checkpoint at time `t` [s]. A state that is missing (the maps' in checkpoints of earlier
-/// formats) is rebuilt from `t` where the observer can, and is an error where it cannot.
-pub fn resume_observers(
-    dir: &Path,
-    problem: &Problem,
-    output: &OutputSettings,
-    saved: &[SavedObserver],
-    t: f64,
-) -> io::Result<Vec<Box<dyn Observer>>> {
-    let required = |key: &str| {
+impl Begin<'_> {
+    /// The state saved under `key`, an error when the checkpoint holds none (only called
+    /// when resuming).
+    fn required(&self, key: &str) -> io::Result<&[u8]> {
+        let saved = match self {
+            Begin::Resume { saved, .. } => saved,
+            Begin::New => &[][..],
+        };
         saved_state(saved, key).ok_or_else(|| {
             io::Error::new(
                 io::ErrorKind::InvalidData,
                 format!("the checkpoint holds no resume state for the {key} output"),
             )
         })
-    };
-    Ok(vec![
-        Box::new(FrameWriter::resume(
-            dir,
-            &problem.name,
-            output.frame_interval,
-            required(FRAMES_KEY)?,
-        )?),
-        Box::new(HistoryObserver::resume(
-            &dir.join("history.csv"),
-            problem,
-            output,
-            required(HISTORY_KEY)?,
-        )?),
-        Box::new(maps::MapObserver::resume(
-            dir,
-            &output.maps,
-            saved_state(saved, MAPS_KEY),
-            t,
-        )?),
-    ])
+    }
+}
+
+/// An observer of every run: how it begins in an output folder, new or resumed.
+pub trait RunObserver: Observer + Sized + 'static {
+    /// Begins in `dir` for `problem` and `output` as `begin` says: with its files created,
+    /// or going on from its state in a checkpoint.
+    fn begin(
+        dir: &Path,
+        problem: &Problem,
+        output: &OutputSettings,
+        begin: Begin,
+    ) -> io::Result<Self>;
+}
+
+type BeginObserver = fn(&Path, &Problem, &OutputSettings, Begin) -> io::Result<Box<dyn Observer>>;
+
+fn boxed<O: RunObserver>(
+    dir: &Path,
+    problem: &Problem,
+    output: &OutputSettings,
+    begin: Begin,
+) -> io::Result<Box<dyn Observer>> {
+    Ok(Box::new(O::begin(dir, problem, output, begin)?))
+}
+
+/// The observers of every run, in the order they see each step: the VTU frames,
+/// history.csv and the contact maps. A new observer is one line here.
+const RUN_OBSERVERS: [BeginObserver; 3] = [
+    boxed::<FrameWriter>,
+    boxed::<HistoryObserver>,
+    boxed::<maps::MapObserver>,
+];
+
+/// The observers of a run in `dir` ([`RUN_OBSERVERS`]), each begun as `begin` says. When
+/// resuming, a state that is missing (the maps' in checkpoints of earlier formats) is rebuilt
+/// from the checkpoint's time where the observer can, and is an error where it cannot.
+pub fn observers(
+    dir: &Path,
+    problem: &Problem,
+    output: &OutputSettings,
+    begin: Begin,
+) -> io::Result<Vec<Box<dyn Observer>>> {
+    RUN_OBSERVERS
+        .iter()
+        .map(|start| start(dir, problem, output, begin))
+        .collect()
 }
 
 /// An observer's resume state that cannot be read, as an I/O error of kind InvalidData.
@@ -153,6 +172,23 @@ pub struct FrameWriter {
     interval: f64,
     next_time: f64,
     frames: usize,
+}
+
+impl RunObserver for FrameWriter {
+    fn begin(
+        dir: &Path,
+        problem: &Problem,
+        output: &OutputSettings,
+        begin: Begin,
+    ) -> io::Result<Self> {
+        let (name, interval) = (&problem.name, output.frame_interval);
+        match begin {
+            Begin::New => FrameWriter::new(dir, name, interval),
+            Begin::Resume { .. } => {
+                FrameWriter::resume(dir, name, interval, begin.required(FRAMES_KEY)?)
+            }
+        }
+    }
 }
 
 impl FrameWriter {
@@ -902,6 +938,23 @@ fn track_contacts(problem: &Problem, node: usize) -> Vec<(usize, usize)> {
                 .map(|i| (p, i))
         })
         .collect()
+}
+
+impl RunObserver for HistoryObserver {
+    fn begin(
+        dir: &Path,
+        problem: &Problem,
+        output: &OutputSettings,
+        begin: Begin,
+    ) -> io::Result<Self> {
+        let path = dir.join("history.csv");
+        match begin {
+            Begin::New => HistoryObserver::new(&path, problem, output),
+            Begin::Resume { .. } => {
+                HistoryObserver::resume(&path, problem, output, begin.required(HISTORY_KEY)?)
+            }
+        }
+    }
 }
 
 impl HistoryObserver {
