@@ -3,7 +3,7 @@
 //! 130 interrupted by Ctrl-C or SIGTERM with a checkpoint to resume from).
 
 use adhesim::time::StepReport;
-use adhesim_io::run::{Outcome, Progress};
+use adhesim_io::run::{Outcome, Progress, RunSummary};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -354,13 +354,10 @@ fn run(
         Ok(p) => p,
         Err(e) => return fail_input(e),
     };
-    let out = resume.clone().or(out).unwrap_or_else(|| {
-        let name = match &opts.variant {
-            Some(v) => format!("{}-{v}", scenario.problem.name),
-            None => scenario.problem.name.clone(),
-        };
-        PathBuf::from("out").join(name)
-    });
+    let out = resume
+        .clone()
+        .or(out)
+        .unwrap_or_else(|| default_out_dir(&scenario.problem.name, opts.variant.as_deref()));
     let control = adhesim_io::run::RunControl {
         checkpoint_every,
         resume: resume.is_some(),
@@ -368,13 +365,7 @@ fn run(
         stop_after_steps: None,
         refuse_existing_run: !overwrite,
     };
-    let mut progress: Box<dyn Progress> = if quiet {
-        Box::new(adhesim_io::run::Silent)
-    } else if std::io::stderr().is_terminal() {
-        Box::new(Bar::new())
-    } else {
-        Box::new(Lines::new())
-    };
+    let mut progress = progress_sink(quiet);
     if !quiet {
         let verb = if resume.is_some() {
             "resuming"
@@ -392,6 +383,32 @@ fn run(
             Err(e) => return fail_input(format!("{}: {e}", path.display())),
         };
     drop(progress);
+    report_run(&summary, path, &out, quiet)
+}
+
+/// `out/<name>` or, for a variant, `out/<name>-<variant>`.
+fn default_out_dir(name: &str, variant: Option<&str>) -> PathBuf {
+    let name = match variant {
+        Some(v) => format!("{name}-{v}"),
+        None => name.to_string(),
+    };
+    PathBuf::from("out").join(name)
+}
+
+/// Nothing when `quiet`, a bar on a terminal, plain lines in a log or a pipe.
+fn progress_sink(quiet: bool) -> Box<dyn Progress> {
+    if quiet {
+        Box::new(adhesim_io::run::Silent)
+    } else if std::io::stderr().is_terminal() {
+        Box::new(Bar::new())
+    } else {
+        Box::new(Lines::new())
+    }
+}
+
+/// Says how the run of `path` into `out` ended; its exit code (0 finished, 1 stopped early,
+/// 130 interrupted).
+fn report_run(summary: &RunSummary, path: &Path, out: &Path, quiet: bool) -> ExitCode {
     match &summary.outcome {
         Outcome::Finished => {
             if !quiet {
@@ -601,34 +618,10 @@ struct SweepRequest {
 }
 
 fn sweep(path: &Path, r: SweepRequest) -> ExitCode {
-    if let Err(e) = load_options(None, &r.fixed) {
-        return fail_input(e.replace("--set", "--fix"));
-    }
-    let axes = match r
-        .axes
-        .iter()
-        .map(|a| adhesim_io::sweep::Axis::parse(a))
-        .collect::<Result<Vec<_>, _>>()
-    {
-        Ok(a) => a,
-        Err(e) => return fail_input(format!("--set: {e}")),
+    let (plan, out) = match sweep_plan(path, &r) {
+        Ok(planned) => planned,
+        Err(code) => return code,
     };
-    let plan = match adhesim_io::sweep::SweepPlan::new(path, r.variant.clone(), &r.fixed, &axes) {
-        Ok(p) => p,
-        Err(e) => return fail_input(format!("{}: {e}", path.display())),
-    };
-    // The name of the default folder; every case is validated in full below.
-    let base = match load_options(r.variant.clone(), &r.fixed) {
-        Ok(o) => o,
-        Err(e) => return fail_input(e.replace("--set", "--fix")),
-    };
-    let scenario = match adhesim_io::scenario::load_with(path, &base) {
-        Ok(p) => p,
-        Err(e) => return fail_input(e),
-    };
-    let out = r
-        .out
-        .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-sweep", scenario.problem.name)));
     let n_cases = plan.cases.len();
     if r.slurm.slurm {
         return slurm_sweep(
@@ -665,10 +658,43 @@ fn sweep(path: &Path, r: SweepRequest) -> ExitCode {
         quiet: r.quiet,
         start: Instant::now(),
     };
-    let summary = match adhesim_io::sweep::run_sweep(&plan, &options, &out, &progress) {
-        Ok(s) => s,
-        Err(e) => return fail_input(format!("{}: {e}", path.display())),
-    };
+    match adhesim_io::sweep::run_sweep(&plan, &options, &out, &progress) {
+        Ok(summary) => report_sweep(&summary, &out, r.quiet),
+        Err(e) => fail_input(format!("{}: {e}", path.display())),
+    }
+}
+
+/// The cases of the sweep `r` of `path` and its output folder (`--out`, or
+/// `out/<name>-sweep`); the exit code of an invalid request.
+fn sweep_plan(
+    path: &Path,
+    r: &SweepRequest,
+) -> Result<(adhesim_io::sweep::SweepPlan, PathBuf), ExitCode> {
+    if let Err(e) = load_options(None, &r.fixed) {
+        return Err(fail_input(e.replace("--set", "--fix")));
+    }
+    let axes = r
+        .axes
+        .iter()
+        .map(|a| adhesim_io::sweep::Axis::parse(a))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| fail_input(format!("--set: {e}")))?;
+    let plan = adhesim_io::sweep::SweepPlan::new(path, r.variant.clone(), &r.fixed, &axes)
+        .map_err(|e| fail_input(format!("{}: {e}", path.display())))?;
+    // The name of the default folder; every case is validated in full later.
+    let base = load_options(r.variant.clone(), &r.fixed)
+        .map_err(|e| fail_input(e.replace("--set", "--fix")))?;
+    let scenario = adhesim_io::scenario::load_with(path, &base).map_err(fail_input)?;
+    let out = r
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-sweep", scenario.problem.name)));
+    Ok((plan, out))
+}
+
+/// Says how the sweep into `out` ended; its exit code (0 every case finished, 1 some stopped
+/// early, 130 interrupted).
+fn report_sweep(summary: &adhesim_io::sweep::SweepSummary, out: &Path, quiet: bool) -> ExitCode {
     let failed = summary
         .results
         .iter()
@@ -681,7 +707,7 @@ fn sweep(path: &Path, r: SweepRequest) -> ExitCode {
         );
         return ExitCode::from(130);
     }
-    if !r.quiet {
+    if !quiet {
         let kept = if summary.kept > 0 {
             format!(", {} kept from before", summary.kept)
         } else {
