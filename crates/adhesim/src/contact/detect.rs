@@ -205,6 +205,39 @@ impl ContactPoint {
             .map(move |s| (s, w))
     }
 
+    /// The point's stencil: every node whose displacement enters its relative displacement,
+    /// with its signed weight (the slave nodes of [`ContactPoint::slave_nodes`] with +w, the
+    /// master nodes with −w), slave nodes first. H_α is the frame's rows times these weights:
+    /// x_α = F_α Σ_n w_n u_n plus the constant part.
+    pub fn stencil(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+        self.slave_nodes()
+            .chain(self.master.iter().map(|&(m, w)| (m, -w)))
+    }
+
+    /// H_α on the unknowns of a factorised system: node n's unknowns are those of its
+    /// representative `rep[n]`, and the `fixed` unknowns are left out. Each unknown is listed
+    /// once, in increasing order, with the coefficients of the point's three local components.
+    pub fn h_terms(&self, rep: &[usize], fixed: &[bool]) -> Vec<(usize, [f64; 3])> {
+        let mut terms: Vec<(usize, [f64; 3])> = Vec::new();
+        for (node, w) in self.stencil() {
+            for k in 0..3 {
+                let i = 3 * rep[node] + k;
+                if !fixed[i] {
+                    terms.push((i, std::array::from_fn(|c| w * self.frame[c][k])));
+                }
+            }
+        }
+        terms.sort_by_key(|t| t.0);
+        let mut merged: Vec<(usize, [f64; 3])> = Vec::with_capacity(terms.len());
+        for (i, c) in terms {
+            match merged.last_mut() {
+                Some(last) if last.0 == i => (0..3).for_each(|k| last.1[k] += c[k]),
+                _ => merged.push((i, c)),
+            }
+        }
+        merged
+    }
+
     /// Indices in the pair of the slave nodes the point stands for.
     pub fn locals(&self) -> impl Iterator<Item = usize> + '_ {
         std::iter::once(self.local).chain(self.twins.iter().map(|t| t.1))
@@ -247,14 +280,9 @@ impl ContactPoint {
     pub fn add_ht(&self, r: [f64; 3], out: &mut [f64]) {
         let f = &self.frame;
         let g: [f64; 3] = std::array::from_fn(|k| r[0] * f[0][k] + r[1] * f[1][k] + r[2] * f[2][k]);
-        for (s, ws) in self.slave_nodes() {
+        for (n, w) in self.stencil() {
             for k in 0..3 {
-                out[3 * s + k] += ws * g[k];
-            }
-        }
-        for &(m, w) in &self.master {
-            for k in 0..3 {
-                out[3 * m + k] -= w * g[k];
+                out[3 * n + k] += w * g[k];
             }
         }
     }
@@ -262,14 +290,9 @@ impl ContactPoint {
     /// H v: the local components of a global displacement field v.
     pub fn apply_h(&self, v: &[f64]) -> [f64; 3] {
         let mut d = [0.0; 3];
-        for (s, ws) in self.slave_nodes() {
+        for (n, w) in self.stencil() {
             for k in 0..3 {
-                d[k] += ws * v[3 * s + k];
-            }
-        }
-        for &(m, w) in &self.master {
-            for k in 0..3 {
-                d[k] -= w * v[3 * m + k];
+                d[k] += w * v[3 * n + k];
             }
         }
         let (f, d) = (self.frame.map(Vec3::from), Vec3::from(d));

@@ -191,7 +191,7 @@ pub fn point_stiffness(pt: &ContactPoint, diagonal: &[f64], constrained: &[bool]
             .reduce(f64::max)
     };
     let mut compliance = 0.0;
-    for (m, w) in pt.slave_nodes().chain(pt.master.iter().copied()) {
+    for (m, w) in pt.stencil() {
         if let Some(k) = node_k(m) {
             compliance += w * w / k;
         }
@@ -203,11 +203,7 @@ pub fn point_stiffness(pt: &ContactPoint, diagonal: &[f64], constrained: &[bool]
 pub fn couplings(points: &[ContactPoint]) -> Vec<(usize, usize)> {
     let mut pairs = Vec::new();
     for pt in points {
-        let nodes: Vec<usize> = pt
-            .slave_nodes()
-            .map(|(s, _)| s)
-            .chain(pt.master.iter().map(|&(m, _)| m))
-            .collect();
+        let nodes: Vec<usize> = pt.stencil().map(|(n, _)| n).collect();
         for (i, &a) in nodes.iter().enumerate() {
             pairs.extend(nodes[..i].iter().map(|&b| (a, b)));
         }
@@ -240,11 +236,8 @@ pub fn add_contact_tangent(
                 g[i][j] = (0..3).map(|a| f[a][i] * kf[a][j]).sum();
             }
         }
-        // H = [I at the slave, −w_m I at master node m] before the rotation.
-        let nodes: Vec<(usize, f64)> = pt
-            .slave_nodes()
-            .chain(pt.master.iter().map(|&(m, w)| (m, -w)))
-            .collect();
+        // H = [w_s I at the slave nodes, −w_m I at master node m] before the rotation.
+        let nodes: Vec<(usize, f64)> = pt.stencil().collect();
         for &(a, ca) in &nodes {
             for &(b, cb) in &nodes {
                 if a <= b {

@@ -46,7 +46,7 @@ const MAX_INNER: usize = 100;
 /// The semismooth Newton contact solve of one step.
 pub struct MixedCoupling<'a> {
     sc: StepContact<'a>,
-    /// H of each point on the factorised system's unknowns (see [`point_h`]).
+    /// H of each point on the factorised system's unknowns (see [`ContactPoint::h_terms`]).
     h: Vec<Vec<(usize, [f64; 3])>>,
     workspace: &'a mut MixedWorkspace,
     /// Total contact force of each point at the last solve, local frames [N].
@@ -86,33 +86,6 @@ impl<'a> MixedCoupling<'a> {
             iterations: 0,
         })
     }
-}
-
-/// H of point `pt` on the unknowns of the factorised system: node n's unknowns are those of
-/// its representative `rep[n]`, and the `fixed` unknowns are left out. Each unknown is listed
-/// once, with the coefficients of the point's three local components.
-pub fn point_h(pt: &ContactPoint, rep: &[usize], fixed: &[bool]) -> Vec<(usize, [f64; 3])> {
-    let mut terms: Vec<(usize, [f64; 3])> = Vec::new();
-    let nodes = pt
-        .slave_nodes()
-        .chain(pt.master.iter().map(|&(m, w)| (m, -w)));
-    for (node, w) in nodes {
-        for k in 0..3 {
-            let i = 3 * rep[node] + k;
-            if !fixed[i] {
-                terms.push((i, std::array::from_fn(|c| w * pt.frame[c][k])));
-            }
-        }
-    }
-    terms.sort_by_key(|t| t.0);
-    let mut merged: Vec<(usize, [f64; 3])> = Vec::with_capacity(terms.len());
-    for (i, c) in terms {
-        match merged.last_mut() {
-            Some(last) if last.0 == i => (0..3).for_each(|k| last.1[k] += c[k]),
-            _ => merged.push((i, c)),
-        }
-    }
-    merged
 }
 
 /// x_α + H_α v for each point, from the local displacements `x` [m] and a global field `v`.
@@ -157,7 +130,7 @@ impl<'a> ContactCoupling<'a> for MixedCoupling<'a> {
         let sc = &self.sc;
         if self.h.is_empty() {
             let (rep, fixed) = (system.representatives(), system.fixed());
-            self.h = sc.points.iter().map(|p| point_h(p, rep, fixed)).collect();
+            self.h = sc.points.iter().map(|p| p.h_terms(rep, fixed)).collect();
         }
         // The start: x at the iterate, the forces r_prev, and the out-of-balance force
         // m = Hᵀr_prev − G that the first direction removes with the contact law's residual.
