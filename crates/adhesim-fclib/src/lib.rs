@@ -655,7 +655,8 @@ pub fn solve_global(
     max_iter: usize,
 ) -> Result<ReducedSolution, String> {
     use adhesim::contact::history::PointHistory;
-    use adhesim::contact::law::{InterfaceLaw, PointSolution};
+    use adhesim::contact::interface::PointSolution;
+    use adhesim::contact::law::InterfaceLaw;
     use adhesim::contact::mixed::{linearise_point, solve_mixed, LuDirection, MixedOperator};
     use adhesim::contact::natural_map::{natural_map_residual, relative_error};
     use std::collections::BTreeMap;

@@ -7,7 +7,9 @@
 
 use crate::output::settings::{MapRequest, OutputSettings, Track};
 use adhesim::contact::detect::{thickness_twins, tributary_areas};
-use adhesim::contact::law::{Interface, Orthotropy, DEFAULT_BETA_EPS};
+use adhesim::contact::interface::Interface;
+use adhesim::contact::law::Orthotropy;
+use adhesim::contact::rcc::DEFAULT_BETA_EPS;
 use adhesim::contact::{ContactPair, InterfaceLaw, Master, RccParams, RigidMotion, RigidShape};
 use adhesim::material::{self, Hyperelastic};
 use adhesim::mesh::generate::{self, FlatSide};

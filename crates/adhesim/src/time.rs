@@ -20,10 +20,11 @@ pub use attempt::PhaseTimes;
 pub use constraints::{thickness_ties, Constraints};
 
 use crate::assembly::{BadElement, Discretisation};
+use crate::contact::cone::ContactState;
 use crate::contact::detect::{align_frames, detect, ContactPoint};
 use crate::contact::history::NodeHistory;
 use crate::contact::history::PointHistory;
-use crate::contact::law::{ContactState, Interface, PointSolution};
+use crate::contact::interface::{Interface, PointSolution};
 use crate::contact::mixed::MixedWorkspace;
 use crate::linalg::LinalgError;
 use crate::problem::{ContactSolver, Problem};

@@ -13,7 +13,7 @@
 //!   fewer than [`MIN_ELEMENTS_ACROSS_CONTACT`] slave elements, measured where the contact
 //!   starts (the local element size, not the mean over the surface).
 
-use crate::contact::law::{Interface, PairScales};
+use crate::contact::interface::{Interface, PairScales};
 pub use crate::contact::rcc::{cohesive_zone_length, CN_STIFFNESS_RATIO};
 use crate::contact::{Master, RigidShape};
 use crate::mesh::Mesh;

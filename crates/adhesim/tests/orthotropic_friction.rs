@@ -9,11 +9,10 @@
 
 use adhesim::contact::anisotropic::{sliding_friction, Orthotropy};
 use adhesim::contact::history::{LawPointHistory, PointHistory};
-use adhesim::contact::law::{
-    adhesive_response, natural_map_defect, solve_point, BondState, InterfaceLaw, PointProblem,
-    RccParams,
-};
+use adhesim::contact::law::{natural_map_defect, InterfaceLaw};
 use adhesim::contact::newton::augmented_point;
+use adhesim::contact::point::{solve_point, PointProblem};
+use adhesim::contact::rcc::{adhesive_response, BondState, RccParams};
 use adhesim::time::Stepper;
 use adhesim::{mat3_from_rows, Mat3, Vec2, Vec3};
 use std::path::Path;

@@ -30,7 +30,7 @@ pub fn field_label(field: &str) -> Option<&'static str> {
         "ft_norm_sum" => "sum of the nodal tangential force norms Σ‖r_t‖ [N]",
         "ft_adh_norm_sum" => "sum of the nodal adhesive tangential force norms Σ‖r̃_t‖ [N]",
         "bonded" => "bonded contact nodes [-]",
-        _ => return adhesim::contact::history::field_label(field),
+        _ => return adhesim::contact::registry::field_label(field),
     })
 }
 

@@ -17,7 +17,8 @@ use super::{
 use crate::codec::{decode_with, encode_with, Codec};
 use crate::output::settings::MapRequest;
 use crate::output::settings::OutputSettings;
-use adhesim::contact::history::{self, FieldKind, HistoryField};
+use adhesim::contact::history::{FieldKind, HistoryField};
+use adhesim::contact::registry;
 use adhesim::contact::Interface;
 use adhesim::problem::Problem;
 use std::collections::BTreeMap;
@@ -33,7 +34,7 @@ pub fn map_fields(fields: &[HistoryField]) -> Vec<&'static str> {
 /// Whether a map CSV column is a contact field of some law.
 fn is_map_field(name: &str) -> bool {
     CONTACT_NODE_FIELDS.contains(&name)
-        || history::registered_fields().any(|f| f.kind == FieldKind::Scalar && f.name == name)
+        || registry::registered_fields().any(|f| f.kind == FieldKind::Scalar && f.name == name)
 }
 
 /// Colour-bar label (quantity and units) of a map field.
@@ -51,7 +52,7 @@ fn map_label(field: &str) -> &'static str {
         "pn_adh" => "adhesive normal traction [Pa]",
         "tt" => "tangential traction ‖t_t‖ [Pa]",
         "tt_adh" => "adhesive tangential traction [Pa]",
-        _ => history::field_label(field).unwrap_or(""),
+        _ => registry::field_label(field).unwrap_or(""),
     }
 }
 
@@ -358,7 +359,7 @@ pub fn draw_map_figures(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
             let values: Vec<f64> = m.rows.iter().map(|r| r[c]).collect();
             let range = match name.as_str() {
                 "state" => Some((0.0, 3.0)),
-                _ if history::field_range(name).is_some() => history::field_range(name),
+                _ if registry::field_range(name).is_some() => registry::field_range(name),
                 _ => ranges
                     .get(&(m.pair.clone(), name.clone()))
                     .copied()

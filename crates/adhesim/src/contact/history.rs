@@ -8,13 +8,13 @@
 //! a law-agnostic [`NodeHistory`] (a short array of numbers in the order of its fields). The
 //! stepper stores a [`NodeHistory`] per slave node; the law turns it back into its typed
 //! history at the start of a step and writes the committed one at its end
-//! ([`super::law::Interface`]).
+//! ([`super::interface::Interface`]).
 //!
 //! Within a step a contact point carries its law's history frozen at the start of the step,
 //! in the point's local frame, as a [`PointHistory`]: plain numbers again, which the law
-//! writes ([`super::law::Interface::point_history`]) and reads (its adhesive evaluation and
+//! writes ([`super::interface::Interface::point_history`]) and reads (its adhesive evaluation and
 //! its commit) through its own typed view ([`LawPointHistory`], e.g. RCC's
-//! [`super::law::BondState`]). The point solvers, the stepper and the fclib bridge only pass
+//! [`super::rcc::BondState`]). The point solvers, the stepper and the fclib bridge only pass
 //! it along; a point's solution carries the history the step leads to in the same form.
 
 /// Largest number of values a node's history holds ([`NodeHistory`]): a scalar field takes
@@ -151,26 +151,4 @@ pub trait LawHistory: Copy + Default + PartialEq + std::fmt::Debug {
 
     /// The history whose [`LawHistory::encode`] is `h`.
     fn decode(h: &NodeHistory) -> Self;
-}
-
-/// The history fields of every registered law (one list per law), for the labels of
-/// figures drawn from a history file alone.
-pub fn registered_fields() -> impl Iterator<Item = &'static HistoryField> {
-    super::law::REGISTERED_HISTORIES
-        .iter()
-        .flat_map(|f| f.iter())
-}
-
-/// Quantity and unit of the history field `name` of any registered law.
-pub fn field_label(name: &str) -> Option<&'static str> {
-    registered_fields()
-        .find(|f| f.name == name)
-        .map(|f| f.label)
-}
-
-/// Fixed colour range of the maps of the history field `name` of any registered law.
-pub fn field_range(name: &str) -> Option<(f64, f64)> {
-    registered_fields()
-        .find(|f| f.name == name)
-        .and_then(|f| f.range)
 }

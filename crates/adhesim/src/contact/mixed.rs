@@ -30,11 +30,12 @@
 use faer::sparse::{Pair, SymbolicSparseColMat};
 
 use super::anisotropic::{scale, unscale};
-use super::history::PointHistory;
-use super::law::{
+use super::cone::{
     bipotential_trial, dry_projection, modified_displacement_jacobian, projection_jacobian,
-    Interface, InterfaceLaw, PointSolution,
 };
+use super::history::PointHistory;
+use super::interface::{Interface, PointSolution};
+use super::law::InterfaceLaw;
 use super::semismooth::{ARMIJO, ETA_DOWN, ETA_MAX, ETA_MIN, ETA_START, ETA_UP};
 use crate::linalg::{metis_dof_ordering, BlockPattern};
 use crate::sparse_lu::OrderedLu;
@@ -513,7 +514,7 @@ pub fn solve_mixed(
 mod tests {
     use super::super::anisotropic::Orthotropy;
     use super::super::history::LawPointHistory;
-    use super::super::law::{BondState, RccParams};
+    use super::super::rcc::{BondState, RccParams};
     use super::super::reduced::test_support::{random_spd, Lcg};
     use super::super::reduced::BlockSparseDelassus;
     use super::super::semismooth::semismooth_newton;

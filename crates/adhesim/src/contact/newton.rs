@@ -19,11 +19,11 @@
 //! Everything here is pure: the stepper owns the loop.
 
 use super::anisotropic::{scale, scale_matrix, unscale};
+use super::cone::{bipotential_trial, dry_projection, ContactState};
 use super::detect::ContactPoint;
 use super::history::PointHistory;
-use super::law::{
-    bipotential_trial, dry_projection, ContactState, Interface, InterfaceLaw, PointSolution,
-};
+use super::interface::{Interface, PointSolution};
+use super::law::InterfaceLaw;
 use crate::system::SystemMatrix;
 use crate::{Mat3, Vec3};
 
@@ -262,8 +262,9 @@ pub fn defect_norm(evals: &[AugmentedPoint]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::contact::cone::ContactState;
     use crate::contact::history::LawPointHistory;
-    use crate::contact::law::{adhesive_response, BondState, ContactState, RccParams};
+    use crate::contact::rcc::{adhesive_response, BondState, RccParams};
     use crate::Vec2;
 
     fn dry(mu: f64) -> InterfaceLaw {

@@ -10,8 +10,9 @@
 //! ([`relative_error`] of [`natural_map_residual`]).
 
 use super::history::PointHistory;
-use super::law::{default_rho, solve_point, InterfaceLaw, PointProblem};
+use super::law::InterfaceLaw;
 use super::natural_map::{natural_map_residual, relative_error};
+use super::point::{default_rho, solve_point, PointProblem};
 use crate::mat3_from_rows;
 
 type M3 = [[f64; 3]; 3];

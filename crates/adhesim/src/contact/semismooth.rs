@@ -37,7 +37,7 @@ use faer::{Conj, MatMut, Par, Spec};
 
 use crate::linalg::faer_call;
 
-use super::law::{
+use super::cone::{
     bipotential_trial, dry_projection, modified_displacement_jacobian, projection_jacobian,
 };
 use super::natural_map::{natural_map_point, natural_map_residual, relative_error};

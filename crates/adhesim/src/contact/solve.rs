@@ -4,7 +4,9 @@
 
 use super::detect::ContactPoint;
 use super::history::PointHistory;
-use super::law::{default_rho, solve_point, InterfaceLaw, PointProblem, PointSolution};
+use super::interface::PointSolution;
+use super::law::InterfaceLaw;
+use super::point::{default_rho, solve_point, PointProblem};
 use crate::linalg::LinearSolve;
 use crate::{mat3_from_rows, Mat3};
 

@@ -3,7 +3,7 @@
 
 use crate::contact::detect::ContactPoint;
 use crate::contact::history::PointHistory;
-use crate::contact::law::PointSolution;
+use crate::contact::interface::PointSolution;
 
 /// Wall time spent in each phase of a step [s].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

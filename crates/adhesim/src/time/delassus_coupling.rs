@@ -7,7 +7,7 @@ use super::coupling::{ContactCoupling, Iterate, StepContact};
 use super::integrator::norm;
 use super::PhaseTimes;
 use crate::contact::detect::ContactPoint;
-use crate::contact::law::PointSolution;
+use crate::contact::interface::PointSolution;
 use crate::contact::solve::{delassus, gauss_seidel, Delassus};
 use crate::system::SystemMatrix;
 use std::time::Instant;

@@ -12,7 +12,7 @@
 use super::coupling::{ContactCoupling, Iterate, StepContact};
 use super::PhaseTimes;
 use crate::contact::detect::ContactPoint;
-use crate::contact::law::PointSolution;
+use crate::contact::interface::PointSolution;
 use crate::contact::mixed::{
     add_ht_terms, apply_h_terms, linearise_point, solve_mixed, Direction, LuDirection,
     MixedDirection, MixedOperator, MixedPattern, MixedWorkspace, PointLinearisation,

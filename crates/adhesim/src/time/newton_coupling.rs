@@ -5,7 +5,8 @@
 
 use super::attempt::PhaseTimes;
 use super::coupling::{ContactCoupling, Evaluated, Iterate, StepContact};
-use crate::contact::law::{ContactState, PointSolution};
+use crate::contact::cone::ContactState;
+use crate::contact::interface::PointSolution;
 use crate::contact::newton::{self, augmented_point, AugmentedPoint};
 use crate::rows_of;
 use crate::system::SystemMatrix;
