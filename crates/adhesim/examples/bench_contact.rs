@@ -25,7 +25,8 @@
 //!
 //! Run `cargo run --release --example bench_contact -- --help` for the options.
 
-use adhesim::contact::detect::{detect, ContactPoint};
+use adhesim::contact::detect::ContactPoint;
+use adhesim::contact::discretisation::detect;
 use adhesim::contact::history::PointHistory;
 use adhesim::contact::solve::{delassus, gauss_seidel, Delassus};
 use adhesim::linalg::SparseCholesky;

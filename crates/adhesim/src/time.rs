@@ -21,7 +21,8 @@ pub use constraints::{thickness_ties, Constraints};
 
 use crate::assembly::{BadElement, Discretisation};
 use crate::contact::cone::ContactState;
-use crate::contact::detect::{align_frames, detect, ContactPoint};
+use crate::contact::detect::{align_frames, ContactPoint};
+use crate::contact::discretisation::detect;
 use crate::contact::history::NodeHistory;
 use crate::contact::history::PointHistory;
 use crate::contact::interface::{Interface, PointSolution};

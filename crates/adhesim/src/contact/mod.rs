@@ -11,12 +11,14 @@
 pub mod anisotropic;
 pub mod cone;
 pub mod detect;
+pub mod discretisation;
 pub mod history;
 pub mod interface;
 pub mod law;
 pub mod mixed;
 pub mod natural_map;
 pub mod newton;
+pub mod node_to_surface;
 pub mod point;
 pub mod rcc;
 pub mod reduced;
