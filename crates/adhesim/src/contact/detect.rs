@@ -300,6 +300,25 @@ impl ContactPoint {
     }
 }
 
+/// How a contact pair is discretised: the contact sites it has at the start of a step. A
+/// discretisation is one file (node-to-surface: `node_to_surface.rs`).
+pub trait Discretisation: std::fmt::Debug + Send + Sync {
+    /// Its name in scenario files and messages.
+    fn name(&self) -> &'static str;
+
+    /// The candidate sites of pair `pair_index` (`pair`) at the start of a step [t0, t1] [s]
+    /// from the reference coordinates [m] and the displacement `u0` [m].
+    fn sites(
+        &self,
+        pair_index: usize,
+        pair: &ContactPair,
+        reference: &[[f64; 3]],
+        u0: &[f64],
+        t0: f64,
+        t1: f64,
+    ) -> Vec<ContactPoint>;
+}
+
 /// Closest point, outward unit normal and signed gap of a point (in the surface's
 /// reference frame).
 pub fn rigid_projection(shape: &RigidShape, x: [f64; 3]) -> ([f64; 3], [f64; 3], f64) {

@@ -6,9 +6,8 @@
 
 use super::detect::{
     frame_from_normal, project_on_face, rigid_projection, unit, ContactPair, ContactPoint,
-    FaceGrid, Master,
+    Discretisation, FaceGrid, Master,
 };
-use super::discretisation::Discretisation;
 use crate::Vec3;
 
 /// The node-to-surface discretisation of a contact pair.
