@@ -11,16 +11,14 @@
 use super::csv::read_history;
 use super::plot::{draw_scalar_map_with, ColorMap, PlotError, ScalarMap, ScalarValues};
 use super::{
-    bad_state, contact_node_fields, contact_node_values, saved_state, Begin, Observer, RunObserver,
-    StepView, CONTACT_NODE_FIELDS, MAPS_KEY,
+    bad_state, contact_node_fields, contact_node_values, saved_state, Begin, Observer, StepView,
+    CONTACT_NODE_FIELDS, MAPS_KEY,
 };
 use crate::codec::{decode_with, encode_with, Codec};
 use crate::output::settings::MapRequest;
-use crate::output::settings::OutputSettings;
 use adhesim::contact::history::{FieldKind, HistoryField};
 use adhesim::contact::registry;
 use adhesim::contact::Interface;
-use adhesim::problem::Problem;
 use std::collections::BTreeMap;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -65,23 +63,18 @@ pub struct MapObserver {
     faces_written: Vec<bool>,
 }
 
-impl RunObserver for MapObserver {
-    fn begin(
-        dir: &Path,
-        _problem: &Problem,
-        output: &OutputSettings,
-        begin: Begin,
-    ) -> io::Result<Self> {
+impl MapObserver {
+    /// The maps of `requests` in `dir`: new, or going on from the checkpoint's state (or its
+    /// time, for a checkpoint without one; [`MapObserver::resume`]).
+    pub fn begin(dir: &Path, requests: &[MapRequest], begin: Begin) -> io::Result<Self> {
         match begin {
-            Begin::New => MapObserver::new(dir, &output.maps),
+            Begin::New => MapObserver::new(dir, requests),
             Begin::Resume { saved, t } => {
-                MapObserver::resume(dir, &output.maps, saved_state(saved, MAPS_KEY), t)
+                MapObserver::resume(dir, requests, saved_state(saved, MAPS_KEY), t)
             }
         }
     }
-}
 
-impl MapObserver {
     /// Maps go to `dir/maps/`.
     pub fn new(dir: &Path, requests: &[MapRequest]) -> io::Result<Self> {
         if !requests.is_empty() {

@@ -93,67 +93,43 @@ pub enum Begin<'a> {
     },
 }
 
-impl Begin<'_> {
-    /// The state saved under `key`, an error when the checkpoint holds none (only called
-    /// when resuming).
-    fn required(&self, key: &str) -> io::Result<&[u8]> {
-        let saved = match self {
-            Begin::Resume { saved, .. } => saved,
-            Begin::New => &[][..],
-        };
-        saved_state(saved, key).ok_or_else(|| {
-            io::Error::new(
-                io::ErrorKind::InvalidData,
-                format!("the checkpoint holds no resume state for the {key} output"),
-            )
-        })
-    }
+/// The state saved under `key` among a checkpoint's `saved` states, an error when there is
+/// none.
+fn required_state<'a>(saved: &'a [SavedObserver], key: &str) -> io::Result<&'a [u8]> {
+    saved_state(saved, key).ok_or_else(|| {
+        io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!("the checkpoint holds no resume state for the {key} output"),
+        )
+    })
 }
 
-/// An observer of every run: how it begins in an output folder, new or resumed.
-pub trait RunObserver: Observer + Sized + 'static {
-    /// Begins in `dir` for `problem` and `output` as `begin` says: with its files created,
-    /// or going on from its state in a checkpoint.
-    fn begin(
-        dir: &Path,
-        problem: &Problem,
-        output: &OutputSettings,
-        begin: Begin,
-    ) -> io::Result<Self>;
-}
-
-type BeginObserver = fn(&Path, &Problem, &OutputSettings, Begin) -> io::Result<Box<dyn Observer>>;
-
-fn boxed<O: RunObserver>(
-    dir: &Path,
-    problem: &Problem,
-    output: &OutputSettings,
-    begin: Begin,
-) -> io::Result<Box<dyn Observer>> {
-    Ok(Box::new(O::begin(dir, problem, output, begin)?))
-}
-
-/// The observers of every run, in the order they see each step: the VTU frames,
-/// history.csv and the contact maps. A new observer is one line here.
-const RUN_OBSERVERS: [BeginObserver; 3] = [
-    boxed::<FrameWriter>,
-    boxed::<HistoryObserver>,
-    boxed::<maps::MapObserver>,
-];
-
-/// The observers of a run in `dir` ([`RUN_OBSERVERS`]), each begun as `begin` says. When
-/// resuming, a state that is missing (the maps' in checkpoints of earlier formats) is rebuilt
-/// from the checkpoint's time where the observer can, and is an error where it cannot.
+/// The observers of every run in `dir`, in the order they see each step: the VTU frames,
+/// history.csv and the contact maps, each begun as `begin` says. A new observer is one line
+/// here. When resuming, a state that is missing (the maps' in checkpoints of earlier formats)
+/// is rebuilt from the checkpoint's time where the observer can, and is an error where it
+/// cannot.
 pub fn observers(
     dir: &Path,
     problem: &Problem,
     output: &OutputSettings,
     begin: Begin,
 ) -> io::Result<Vec<Box<dyn Observer>>> {
-    RUN_OBSERVERS
-        .iter()
-        .map(|start| start(dir, problem, output, begin))
-        .collect()
+    Ok(vec![
+        Box::new(FrameWriter::begin(
+            dir,
+            &problem.name,
+            output.frame_interval,
+            begin,
+        )?),
+        Box::new(HistoryObserver::begin(
+            &dir.join("history.csv"),
+            problem,
+            output,
+            begin,
+        )?),
+        Box::new(maps::MapObserver::begin(dir, &output.maps, begin)?),
+    ])
 }
 
 /// An observer's resume state that cannot be read, as an I/O error of kind InvalidData.
@@ -174,24 +150,18 @@ pub struct FrameWriter {
     frames: usize,
 }
 
-impl RunObserver for FrameWriter {
-    fn begin(
-        dir: &Path,
-        problem: &Problem,
-        output: &OutputSettings,
-        begin: Begin,
-    ) -> io::Result<Self> {
-        let (name, interval) = (&problem.name, output.frame_interval);
+impl FrameWriter {
+    /// A writer in `dir` for the run `name` every `interval` [s]: new, or going on from its
+    /// state in a checkpoint ([`FrameWriter::new`], [`FrameWriter::resume`]).
+    pub fn begin(dir: &Path, name: &str, interval: f64, begin: Begin) -> io::Result<Self> {
         match begin {
             Begin::New => FrameWriter::new(dir, name, interval),
-            Begin::Resume { .. } => {
-                FrameWriter::resume(dir, name, interval, begin.required(FRAMES_KEY)?)
+            Begin::Resume { saved, .. } => {
+                FrameWriter::resume(dir, name, interval, required_state(saved, FRAMES_KEY)?)
             }
         }
     }
-}
 
-impl FrameWriter {
     /// Frame `NNNNN` is the multiblock file `DIR/vtu/<name>_NNNNN.vtm` over one grid per body,
     /// `DIR/vtu/<name>_NNNNN_body<i>.vtu`, and one per contact pair,
     /// `DIR/vtu/<name>_NNNNN_contact<j>.vtu`; the collection over time is `DIR/<name>.pvd`.
@@ -940,18 +910,19 @@ fn track_contacts(problem: &Problem, node: usize) -> Vec<(usize, usize)> {
         .collect()
 }
 
-impl RunObserver for HistoryObserver {
-    fn begin(
-        dir: &Path,
+impl HistoryObserver {
+    /// The history at `path`: new, or going on from its state in a checkpoint
+    /// ([`HistoryObserver::new`], [`HistoryObserver::resume`]).
+    pub fn begin(
+        path: &Path,
         problem: &Problem,
         output: &OutputSettings,
         begin: Begin,
     ) -> io::Result<Self> {
-        let path = dir.join("history.csv");
         match begin {
-            Begin::New => HistoryObserver::new(&path, problem, output),
-            Begin::Resume { .. } => {
-                HistoryObserver::resume(&path, problem, output, begin.required(HISTORY_KEY)?)
+            Begin::New => HistoryObserver::new(path, problem, output),
+            Begin::Resume { saved, .. } => {
+                HistoryObserver::resume(path, problem, output, required_state(saved, HISTORY_KEY)?)
             }
         }
     }

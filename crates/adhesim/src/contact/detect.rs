@@ -303,9 +303,6 @@ impl ContactPoint {
 /// How a contact pair is discretised: the contact sites it has at the start of a step. A
 /// discretisation is one file (node-to-surface: `node_to_surface.rs`).
 pub trait Discretisation: std::fmt::Debug + Send + Sync {
-    /// Its name in scenario files and messages.
-    fn name(&self) -> &'static str;
-
     /// The candidate sites of pair `pair_index` (`pair`) at the start of a step [t0, t1] [s]
     /// from the reference coordinates [m] and the displacement `u0` [m].
     fn sites(

@@ -15,10 +15,6 @@ use crate::Vec3;
 pub struct NodeToSurface;
 
 impl Discretisation for NodeToSurface {
-    fn name(&self) -> &'static str {
-        "node-to-surface"
-    }
-
     fn sites(
         &self,
         pi: usize,
