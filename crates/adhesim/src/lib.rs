@@ -7,6 +7,14 @@
 //! elements, materials, contact, time stepping): it parses no scenario and writes no output.
 //!
 //! Units are SI throughout (m, kg, s, N, Pa).
+//!
+//! The public modules are what a program built on the crate uses: the problem
+//! ([`problem`], [`mesh`], [`material`], [`gravity`], the element formulations [`element`],
+//! [`fbar`], [`anp`]), its stepper and what it reports ([`time`], [`assembly`],
+//! [`diagnosis`], [`warnings`]), contact ([`contact`], whose reduced solvers the fclib
+//! benchmarks drive on their own) and the sparse solves the benchmarks time ([`linalg`],
+//! [`sparse_lu`]). The step's system matrix, the prescribed functions of time, the element
+//! kernels and the node-to-surface detection are internal.
 
 pub mod anp;
 pub mod assembly;
@@ -18,10 +26,10 @@ pub mod gravity;
 pub mod linalg;
 pub mod material;
 pub mod mesh;
-pub mod prescribed;
+pub(crate) mod prescribed;
 pub mod problem;
 pub mod sparse_lu;
-pub mod system;
+pub(crate) mod system;
 pub mod time;
 pub mod warnings;
 

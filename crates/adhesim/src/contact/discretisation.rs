@@ -2,7 +2,7 @@
 //! step. Every solver, output and checkpoint sees only the sites
 //! ([`super::detect::ContactPoint`]: signed node weights, a frame, an area and a constant gap
 //! part); a discretisation is one file that implements [`super::detect::Discretisation`]
-//! (node-to-surface: [`super::node_to_surface`]).
+//! (node-to-surface: `node_to_surface`).
 
 use super::detect::{ContactPair, ContactPoint, Discretisation};
 use super::node_to_surface::NodeToSurface;

@@ -11,7 +11,7 @@
 //!   slip increment over the step.
 //! - Interface parameters are per unit area; nodal forces are traction × tributary area `A` [m²].
 //!
-//! The pieces a law is made of live apart: Coulomb's cone in [`super::cone`], what a bond law
+//! The pieces a law is made of live apart: Coulomb's cone in `cone.rs`, what a bond law
 //! provides in [`super::interface`], the point solver in [`super::point`], RCC's maths in
 //! [`super::rcc`] and the registry of laws in [`super::registry`].
 

@@ -1,15 +1,34 @@
-//! Frictional contact with recoverable adhesion (docs/model.md §4-§7).
+//! Frictional contact with recoverable adhesion (docs/model.md §4-§7), in three parts.
 //!
-//! - [`law`]: the local law at one contact point (bi-potential projection, RCC β update, the
-//!   point solver) — pure functions.
-//! - [`history`]: a law's history at a slave node, its named fields and values; [`rcc`]: the
-//!   RCC law's history and its [`interface::Interface`] implementation.
-//! - [`detect`]: contact pairs, detection once per step, local frames, gaps and the operator H.
-//! - [`solve`]: the reduced contact system inside Newton (Delassus operator W = H K̄⁻¹ Hᵀ,
-//!   nonlinear Gauss-Seidel over contact points).
+//! Kinematics (where the contact sites are, and how they move with the nodes):
+//! - [`detect`]: contact pairs, a site's kinematics ([`detect::ContactPoint`]: local frame,
+//!   gap, area and its stencil, the signed (node, weight) pairs of H), rigid master shapes,
+//!   tributary areas and the [`detect::Discretisation`] trait;
+//! - [`discretisation`]: the sites of every pair at the start of a step;
+//!   `node_to_surface`: single-pass node-to-surface detection, the first discretisation.
+//!
+//! Laws (what happens at one site):
+//! - `cone`: Coulomb's cone and the bi-potential projection; [`anisotropic`]: the elliptic
+//!   cone of orthotropic interfaces;
+//! - [`interface`]: what a bond law gives the solvers (the [`Interface`] trait);
+//!   [`rcc`]: the Raous-Cangémi-Cocou law, its parameters, maths and history;
+//!   [`law`]: a pair's law (its cone and its bonds); [`history`]: a law's history at a site,
+//!   with named fields; [`registry`]: the laws the program knows, for what is drawn from a
+//!   history file alone;
+//! - [`point`]: the point solver of the Gauss-Seidel sweep.
+//!
+//! Solvers (the contact problem of a Newton iteration; the coupling to the step is in
+//! `time/`):
+//! - [`solve`]: the Delassus operator W = H K̄⁻¹ Hᵀ and nonlinear Gauss-Seidel over sites;
+//! - [`mixed`]: the W-free semismooth solve on the mixed system (the default above 200
+//!   candidate sites);
+//! - [`newton`]: the augmented-Lagrangian contact terms inside the step's own Newton loop;
+//! - [`reduced`] and [`semismooth`]: the reduced dry problem x = q + W r without a mesh
+//!   (Gauss-Seidel and semismooth Newton), as the fclib benchmarks pose it;
+//!   [`natural_map`]: its error measure.
 
 pub mod anisotropic;
-pub mod cone;
+pub(crate) mod cone;
 pub mod detect;
 pub mod discretisation;
 pub mod history;
@@ -18,7 +37,7 @@ pub mod law;
 pub mod mixed;
 pub mod natural_map;
 pub mod newton;
-pub mod node_to_surface;
+pub(crate) mod node_to_surface;
 pub mod point;
 pub mod rcc;
 pub mod reduced;

@@ -8,8 +8,8 @@
 //! F(r, x) = r − P_K(r − ρ (x + μ‖x_t‖ n)) = 0
 //!
 //! for any ρ > 0, where P_K is the projection onto the Coulomb cone K_μ
-//! ([`super::cone::dry_projection`]) and `x + μ‖x_t‖ n` is the bi-potential's modified relative
-//! displacement ([`super::cone::bipotential_trial`]).
+//! (`cone::dry_projection`) and `x + μ‖x_t‖ n` is the bi-potential's modified relative
+//! displacement (`cone::bipotential_trial`).
 //!
 //! # Normalisation
 //! [`natural_map_residual`] returns the plain Euclidean norm over all points,

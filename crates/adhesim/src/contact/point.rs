@@ -1,6 +1,6 @@
 //! The point solver of the nonlinear Gauss–Seidel sweep over contact points: the local problem
 //! x = x_free + W_αα (r̄ + r̃) at one point, with the dry force r̄ on Coulomb's cone
-//! ([`super::cone`]) and the adhesive force r̃ of the pair's bond law ([`super::interface`]).
+//! (`cone.rs`) and the adhesive force r̃ of the pair's bond law ([`super::interface`]).
 //! Pure functions on plain arrays: no mesh, no allocation.
 //!
 //! [`solve_point`] solves the apart, stick and slide cases directly (the adhesive part

@@ -11,13 +11,13 @@
 //!   and the assembly loops are compiled for each type (no dynamic dispatch per element or
 //!   Gauss point).
 //!
-//! The types are trilinear hex8 (2×2×2 Gauss, [`hex8`]) and linear tet4 (1 point, [`tet4`]).
+//! The types are trilinear hex8 (2×2×2 Gauss, `hex8.rs`) and linear tet4 (1 point, `tet4.rs`).
 //! Reference-configuration data (shape-function gradients, weights) are computed once; the
 //! kernels turn nodal displacements into internal force, consistent tangent (material +
 //! geometric) and strain energy.
 
-pub mod hex8;
-pub mod tet4;
+pub(crate) mod hex8;
+pub(crate) mod tet4;
 
 pub use hex8::{
     hex8_centre, hex8_gauss_points, hex8_geometry, hex8_shape, Hex8, HEX8, HEX_NODE_XI,

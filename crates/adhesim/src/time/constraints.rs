@@ -81,7 +81,7 @@ impl Constraints {
     }
 }
 
-/// The representative of each node (see [`crate::system::SystemMatrix`]). In a plane-strain
+/// The representative of each node (see `SystemMatrix`). In a plane-strain
 /// body the nodes of one line through the thickness (same reference x and y) share the
 /// unknowns of the line's first node, provided they have the same prescribed components
 /// (`fixed`, per unknown) and every contact pair that touches the body makes such a line one

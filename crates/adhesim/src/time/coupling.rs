@@ -1,8 +1,9 @@
-//! The contact stage of a step: the candidates found at its start, and the two ways of
+//! The contact stage of a step: the candidates found at its start, and the three ways of
 //! solving the contact conditions inside the Newton loop behind one trait
 //! ([`ContactCoupling`]): Gauss-Seidel on the Delassus operator
-//! ([`super::delassus_coupling`]) and the augmented-Lagrangian Newton solve
-//! ([`super::newton_coupling`]). docs/contact-solver.md describes both.
+//! ([`super::delassus_coupling`]), the W-free semismooth solve on the mixed system
+//! ([`super::mixed_coupling`]) and the augmented-Lagrangian Newton solve
+//! ([`super::newton_coupling`]). docs/contact-solver.md describes all three.
 
 use super::attempt::PhaseTimes;
 use super::constraints::Constraints;
