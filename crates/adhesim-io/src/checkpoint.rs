@@ -20,7 +20,7 @@ use crate::output::{
 };
 use adhesim::contact::history::MAX_HISTORY_VALUES;
 use adhesim::problem::Problem;
-use adhesim::time::{CachedDelassus, DelassusCache, NodeContact, Snapshot};
+use adhesim::time::{CachedDelassus, DelassusCache, SiteContact, Snapshot};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -300,7 +300,7 @@ impl Checkpoint {
                      {MAX_HISTORY_VALUES} this version of adhesim holds"
                 ));
             }
-            c.count(nodes, 8 * (NodeContact::VALUES + stored) + 4)?;
+            c.count(nodes, 8 * (SiteContact::VALUES + stored) + 4)?;
             for node in nodes.iter_mut() {
                 let mut values = node.to_values();
                 for x in &mut values {
@@ -312,7 +312,7 @@ impl Checkpoint {
                 for x in &mut history.0[..stored] {
                     c.f64(x)?;
                 }
-                *node = NodeContact::from_values(&values, state, history);
+                *node = SiteContact::from_values(&values, state, history);
             }
         }
         c.f64s(&mut s.material_history)?;
@@ -359,10 +359,10 @@ fn legacy_observers(c: &mut impl Codec, observers: &mut Vec<SavedObserver>) -> R
 }
 
 /// The contact nodes of a pair in format 4: per node β, u_t (3), then the
-/// [`NodeContact::to_values`], then D, then the state code. β, u_t and D are the first five
+/// [`SiteContact::to_values`], then D, then the state code. β, u_t and D are the first five
 /// values of the RCC law's history ([`adhesim::contact::RccHistory`]), in its order.
-fn rcc_only_nodes(c: &mut impl Codec, nodes: &mut Vec<NodeContact>) -> Result<(), String> {
-    c.count(nodes, 8 * (NodeContact::VALUES + 5) + 4)?;
+fn rcc_only_nodes(c: &mut impl Codec, nodes: &mut Vec<SiteContact>) -> Result<(), String> {
+    c.count(nodes, 8 * (SiteContact::VALUES + 5) + 4)?;
     for node in nodes.iter_mut() {
         let mut history = node.history;
         let mut values = node.to_values();
@@ -372,7 +372,7 @@ fn rcc_only_nodes(c: &mut impl Codec, nodes: &mut Vec<NodeContact>) -> Result<()
         c.f64(&mut history.0[4])?;
         let mut state = node.state;
         c.i32(&mut state)?;
-        *node = NodeContact::from_values(&values, state, history);
+        *node = SiteContact::from_values(&values, state, history);
     }
     Ok(())
 }
@@ -411,7 +411,7 @@ mod tests {
     use adhesim::contact::LawHistory;
 
     fn sample() -> Checkpoint {
-        let c = NodeContact {
+        let c = SiteContact {
             history: adhesim::contact::RccHistory {
                 beta: 0.25,
                 ut: [1e-9, -2e-9, 0.0],
@@ -441,7 +441,7 @@ mod tests {
                 f_int0: vec![-1.5; 4],
                 external_work: 2.0,
                 last_internal: 1.0,
-                contact: vec![vec![c, NodeContact::default()], vec![]],
+                contact: vec![vec![c, SiteContact::default()], vec![]],
                 material_history: vec![0.25, -1e-9],
                 delassus: Some(CachedDelassus {
                     key: vec![7, u64::MAX],

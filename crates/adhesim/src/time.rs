@@ -23,7 +23,7 @@ use crate::assembly::{BadElement, Discretisation};
 use crate::contact::cone::ContactState;
 use crate::contact::detect::{align_frames, ContactPoint};
 use crate::contact::discretisation::detect;
-use crate::contact::history::NodeHistory;
+use crate::contact::history::SiteHistory;
 use crate::contact::history::PointHistory;
 use crate::contact::interface::{Interface, PointSolution};
 use crate::contact::mixed::MixedWorkspace;
@@ -128,22 +128,24 @@ pub struct StepReport {
     pub timings: PhaseTimes,
 }
 
-/// The contact state of one slave node, committed at the end of every step: what every
-/// interface law has (forces, gap, slip, state, frame) and the law's own history.
+/// The contact state of one contact site of a pair (a slave node, for node-to-surface
+/// contact), committed at the end of every step: what every interface law has (forces, gap,
+/// slip, state, frame) and the law's own history. A pair's sites are numbered by its
+/// discretisation, in the order of [`crate::contact::ContactPair::slave_nodes`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct NodeContact {
-    /// The interface law's history at the node, in the order of its named fields
+pub struct SiteContact {
+    /// The interface law's history at the site, in the order of its named fields
     /// ([`crate::contact::Interface::history_fields`]); e.g. β, u_t and D of the RCC law
-    /// ([`crate::contact::RccHistory`]). Kept when the node leaves contact, as the law says
+    /// ([`crate::contact::RccHistory`]). Kept when the site leaves contact, as the law says
     /// ([`crate::contact::Interface::release`]).
-    pub history: NodeHistory,
+    pub history: SiteHistory,
     /// Dry force r̄ in the local frame (t₁, t₂, n) [N].
     pub r_dry: [f64; 3],
     /// Adhesive force r̃ in the local frame [N].
     pub r_adh: [f64; 3],
-    /// Total contact force on the slave node in global axes [N].
+    /// Total contact force on the site in global axes [N].
     pub force: [f64; 3],
-    /// Gap at the end of the step x_n [m] (NaN when the node is not a candidate).
+    /// Gap at the end of the step x_n [m] (NaN when the site is not a candidate).
     pub gap: f64,
     /// Slip increment over the step (t₁, t₂) [m].
     pub slip: [f64; 2],
@@ -153,14 +155,14 @@ pub struct NodeContact {
     pub tangent_axes: [[f64; 3]; 2],
 }
 
-impl NodeContact {
-    /// How many numbers [`NodeContact::to_values`] gives (the state code and the law's
+impl SiteContact {
+    /// How many numbers [`SiteContact::to_values`] gives (the state code and the law's
     /// history aside).
     pub const VALUES: usize = 18;
 
     /// Every real-valued field but the history, in a fixed order: r̄ (3), r̃ (3), force (3),
-    /// gap, slip (2), tangent axes (2 × 3). With [`NodeContact::state`] and
-    /// [`NodeContact::history`] this is the whole node (the checkpoint format).
+    /// gap, slip (2), tangent axes (2 × 3). With [`SiteContact::state`] and
+    /// [`SiteContact::history`] this is the whole site (the checkpoint format).
     pub fn to_values(&self) -> [f64; Self::VALUES] {
         let mut v = [0.0; Self::VALUES];
         let parts: [&[f64]; 6] = [
@@ -177,11 +179,11 @@ impl NodeContact {
         v
     }
 
-    /// The node whose [`NodeContact::to_values`] are `v`, with state code `state` and
+    /// The site whose [`SiteContact::to_values`] are `v`, with state code `state` and
     /// history `history`.
-    pub fn from_values(v: &[f64; Self::VALUES], state: i32, history: NodeHistory) -> Self {
+    pub fn from_values(v: &[f64; Self::VALUES], state: i32, history: SiteHistory) -> Self {
         let a3 = |k: usize| [v[k], v[k + 1], v[k + 2]];
-        NodeContact {
+        SiteContact {
             history,
             r_dry: a3(0),
             r_adh: a3(3),
@@ -231,8 +233,8 @@ pub struct Snapshot {
     pub external_work: f64,
     /// Strain energy of the committed state [J].
     pub last_internal: f64,
-    /// Committed contact state per pair and slave node.
-    pub contact: Vec<Vec<NodeContact>>,
+    /// Committed contact state per pair and contact site.
+    pub contact: Vec<Vec<SiteContact>>,
     /// Internal variables of the viscoelastic materials (see
     /// [`Discretisation::history`]).
     pub material_history: Vec<f64>,
@@ -260,8 +262,8 @@ pub struct Stepper {
     f_int0: Vec<f64>,
     external_work: f64,
     last_internal: f64,
-    /// Committed contact state per pair and slave node.
-    pub contact: Vec<Vec<NodeContact>>,
+    /// Committed contact state per pair and contact site.
+    pub contact: Vec<Vec<SiteContact>>,
     /// Diagonal of the bounding box of the reference nodes [m].
     model_size: f64,
     /// The last Delassus operator, kept for reuse by the Gauss-Seidel contact solve.
@@ -341,7 +343,7 @@ impl Stepper {
             .iter()
             .map(|c| {
                 vec![
-                    NodeContact {
+                    SiteContact {
                         gap: f64::NAN,
                         ..Default::default()
                     };
@@ -539,7 +541,7 @@ impl Stepper {
         // Nodes that are not candidates of this step keep what their law says.
         for (nodes, pair) in self.contact.iter_mut().zip(&self.problem.contacts) {
             for n in nodes.iter_mut() {
-                *n = NodeContact {
+                *n = SiteContact {
                     gap: f64::NAN,
                     history: pair.law.release(&n.history),
                     ..Default::default()
@@ -555,7 +557,7 @@ impl Stepper {
             // Each slave node of the point carries its share of the forces.
             let share = pt.node_share();
             let part = |v: [f64; 3]| v.map(|c| share * c);
-            let node = NodeContact {
+            let node = SiteContact {
                 history: self.problem.contacts[pt.pair].law.commit(h0, sol, f),
                 r_dry: part(sol.r_dry.into()),
                 r_adh: part(sol.r_adh.into()),

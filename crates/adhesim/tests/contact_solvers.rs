@@ -6,7 +6,7 @@
 
 use adhesim::contact::RccHistory;
 use adhesim::problem::Problem;
-use adhesim::time::{NodeContact, Stepper};
+use adhesim::time::{SiteContact, Stepper};
 use adhesim_io::scenario::{load_with, LoadOptions, Override};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -31,7 +31,7 @@ fn load(file: &str, variant: Option<&str>, overrides: &[&str]) -> Problem {
 }
 
 /// Per committed step: time and the committed contact state of every pair.
-type Trace = Vec<(f64, Vec<Vec<NodeContact>>)>;
+type Trace = Vec<(f64, Vec<Vec<SiteContact>>)>;
 
 /// Runs a problem to its end, checking at every committed step that the contact residual
 /// is within the tolerance.
@@ -59,7 +59,7 @@ fn run(problem: Problem) -> Trace {
 fn worst_difference(
     a: &Trace,
     b: &Trace,
-    field: impl Fn(&NodeContact) -> f64,
+    field: impl Fn(&SiteContact) -> f64,
     scale: f64,
 ) -> (f64, usize) {
     let mut worst: f64 = 0.0;
@@ -85,7 +85,7 @@ fn worst_difference(
 fn worst_interpolated(
     a: &Trace,
     b: &Trace,
-    field: impl Fn(&NodeContact) -> f64,
+    field: impl Fn(&SiteContact) -> f64,
     scale: f64,
 ) -> f64 {
     let mut worst: f64 = 0.0;
@@ -176,7 +176,7 @@ fn compare_with_gauss_seidel_on_the_indentation_cycle(solver: &str) -> Compariso
         Some("coarse"),
         &["time.contact_solver=gauss-seidel"],
     ));
-    let normal = |n: &NodeContact| n.r_dry[2] + n.r_adh[2];
+    let normal = |n: &SiteContact| n.r_dry[2] + n.r_adh[2];
     let f_max = gs
         .iter()
         .flat_map(|(_, c)| c.iter().flatten().map(normal))

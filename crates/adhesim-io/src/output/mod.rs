@@ -15,7 +15,7 @@ use adhesim::contact::history::{FieldKind, HistoryField, Slot};
 use adhesim::contact::{Interface, Master, RigidShape};
 use adhesim::element::von_mises;
 use adhesim::problem::{Dirichlet, Problem};
-use adhesim::time::{NodeContact, State, StepReport};
+use adhesim::time::{SiteContact, State, StepReport};
 use settings::OutputSettings;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -31,8 +31,8 @@ pub struct StepView<'a> {
     pub state: &'a State,
     /// What the step did.
     pub report: &'a StepReport,
-    /// Committed contact state per pair and slave node.
-    pub contact: &'a [Vec<NodeContact>],
+    /// Committed contact state per pair and contact site.
+    pub contact: &'a [Vec<SiteContact>],
     /// Nodal reaction forces of the step [N], 3 per node, zero on free degrees of freedom
     /// (see [`adhesim::time::Stepper::reactions`]).
     pub reactions: &'a [f64],
@@ -486,7 +486,7 @@ struct ContactFrame {
 fn contact_frame(
     index: usize,
     pair: &adhesim::contact::ContactPair,
-    nodes: &[NodeContact],
+    nodes: &[SiteContact],
     view: &StepView,
 ) -> ContactFrame {
     let u = &view.state.u;
@@ -591,7 +591,7 @@ fn with_history<'a>(
 /// Each of the law's history fields `fields` with its values over `nodes`.
 fn history_columns_of(
     fields: &'static [HistoryField],
-    nodes: &[NodeContact],
+    nodes: &[SiteContact],
 ) -> Vec<(&'static HistoryField, HistoryColumn)> {
     let mut at = 0;
     fields
@@ -719,7 +719,7 @@ pub const PAIR_TOTAL_FIELDS: [&str; 14] = [
 /// adhesive parts [N] (a measure of how much tangential force the interface carries, not a
 /// force: opposite nodal forces add up here and cancel in the resultant); the number of
 /// bonded nodes (whose law's bond intensity, the first history value, is positive).
-pub fn pair_totals(nodes: &[NodeContact]) -> [f64; 14] {
+pub fn pair_totals(nodes: &[SiteContact]) -> [f64; 14] {
     let mut out = [0.0; 14];
     for c in nodes {
         let t = c.tangent_axes;
@@ -847,7 +847,7 @@ pub const CONTACT_NODE_FIELDS: [&str; 12] = [
 /// Names of the contact fields of a slave node whose law has the history fields `fields`,
 /// in the order of [`contact_node_values`].
 pub fn contact_node_fields(fields: &[HistoryField]) -> Vec<&'static str> {
-    contact_node_values(&NodeContact::default(), fields, 0.0)
+    contact_node_values(&SiteContact::default(), fields, 0.0)
         .into_iter()
         .map(|(name, _)| name)
         .collect()
@@ -857,7 +857,7 @@ pub fn contact_node_fields(fields: &[HistoryField]) -> Vec<&'static str> {
 /// history fields `fields`, named: the [`CONTACT_NODE_FIELDS`] with the law's scalar history
 /// fields placed by their [`Slot`].
 pub fn contact_node_values(
-    c: &NodeContact,
+    c: &SiteContact,
     fields: &[HistoryField],
     area: f64,
 ) -> Vec<(&'static str, f64)> {
@@ -1117,7 +1117,7 @@ mod tests {
     #[test]
     fn pair_totals_separate_the_resultant_from_the_sum_of_norms() {
         let axes = [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0]];
-        let a = NodeContact {
+        let a = SiteContact {
             r_dry: [3.0, 0.0, 2.0],
             force: [0.0, 2.0, 3.0],
             tangent_axes: axes,
@@ -1128,7 +1128,7 @@ mod tests {
             .encode(),
             ..Default::default()
         };
-        let b = NodeContact {
+        let b = SiteContact {
             r_adh: [-3.0, 0.0, 5.0],
             force: [0.0, 5.0, -3.0],
             tangent_axes: axes,
@@ -1160,7 +1160,7 @@ mod tests {
                 "pn_adh", "tt", "tt_adh", "damage"
             ]
         );
-        let c = NodeContact {
+        let c = SiteContact {
             history: RccHistory {
                 beta: 0.25,
                 ut: [1.0, 2.0, 3.0],

@@ -1,12 +1,12 @@
-//! The history an interface law keeps at each slave node between steps, and what the rest of
+//! The history an interface law keeps at each contact site between steps, and what the rest of
 //! the program knows about it: named fields (name, quantity and unit, kind, where they go in
 //! the outputs) and their values. Outputs (history columns, VTK contact fields, maps,
 //! figures) and checkpoints iterate over these fields; none of them names a law's field.
 //!
 //! A law's history is a typed value (e.g. [`super::rcc::RccHistory`]) that implements
 //! [`LawHistory`]: it lists its [`HistoryField`]s once and encodes itself, in global axes, to
-//! a law-agnostic [`NodeHistory`] (a short array of numbers in the order of its fields). The
-//! stepper stores a [`NodeHistory`] per slave node; the law turns it back into its typed
+//! a law-agnostic [`SiteHistory`] (a short array of numbers in the order of its fields). The
+//! stepper stores a [`SiteHistory`] per contact site; the law turns it back into its typed
 //! history at the start of a step and writes the committed one at its end
 //! ([`super::interface::Interface`]).
 //!
@@ -17,7 +17,7 @@
 //! [`super::rcc::BondState`]). The point solvers, the stepper and the fclib bridge only pass
 //! it along; a point's solution carries the history the step leads to in the same form.
 
-/// Largest number of values a node's history holds ([`NodeHistory`]): a scalar field takes
+/// Largest number of values a site's history holds ([`SiteHistory`]): a scalar field takes
 /// one, a vector field three.
 pub const MAX_HISTORY_VALUES: usize = 8;
 
@@ -35,7 +35,7 @@ pub enum FieldKind {
 /// slip, state, tractions), in the history columns, the maps and the VTK contact fields.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Slot {
-    /// Before the forces: the first contact fields of a node.
+    /// Before the forces: the first contact fields of a site.
     First,
     /// After the gap and slip, before the contact state: with the kinematics.
     Motion,
@@ -59,7 +59,7 @@ pub struct HistoryField {
 }
 
 impl HistoryField {
-    /// How many values the field takes in a [`NodeHistory`].
+    /// How many values the field takes in a [`SiteHistory`].
     pub const fn len(&self) -> usize {
         match self.kind {
             FieldKind::Scalar => 1,
@@ -73,21 +73,21 @@ impl HistoryField {
     }
 }
 
-/// How many values the fields `fields` take in a [`NodeHistory`].
+/// How many values the fields `fields` take in a [`SiteHistory`].
 pub fn values_of(fields: &[HistoryField]) -> usize {
     fields.iter().map(HistoryField::len).sum()
 }
 
-/// The history of one slave node as plain numbers, in the order of its law's
+/// The history of one contact site as plain numbers, in the order of its law's
 /// [`HistoryField`]s (global axes for vectors), zero-padded to [`MAX_HISTORY_VALUES`].
 ///
-/// By convention the first value is the law's bond intensity: a node counts as bonded (the
+/// By convention the first value is the law's bond intensity: a site counts as bonded (the
 /// `bonded` column of a pair) when it is positive. A law without bonds keeps it 0.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct NodeHistory(pub [f64; MAX_HISTORY_VALUES]);
+pub struct SiteHistory(pub [f64; MAX_HISTORY_VALUES]);
 
-impl NodeHistory {
-    /// Whether the node is bonded (its first value is positive).
+impl SiteHistory {
+    /// Whether the site is bonded (its first value is positive).
     pub fn bonded(&self) -> bool {
         self.0[0] > 0.0
     }
@@ -119,7 +119,7 @@ impl NodeHistory {
 /// leads to (in a point's solution). Only the law reads its values
 /// ([`LawPointHistory::decode`]).
 ///
-/// The same convention as [`NodeHistory`]: the first value is the law's bond intensity, the
+/// The same convention as [`SiteHistory`]: the first value is the law's bond intensity, the
 /// point is bonded when it is positive, and a law without bonds keeps it 0.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PointHistory(pub [f64; MAX_HISTORY_VALUES]);
@@ -140,15 +140,15 @@ pub trait LawPointHistory: Copy + Default + PartialEq + std::fmt::Debug {
     fn decode(h: &PointHistory) -> Self;
 }
 
-/// A law's typed history at a slave node.
+/// A law's typed history at a contact site.
 pub trait LawHistory: Copy + Default + PartialEq + std::fmt::Debug {
     /// Its fields, in the order of [`LawHistory::encode`]; together they take at most
     /// [`MAX_HISTORY_VALUES`] values.
     const FIELDS: &'static [HistoryField];
 
     /// The values of its fields, in order.
-    fn encode(&self) -> NodeHistory;
+    fn encode(&self) -> SiteHistory;
 
     /// The history whose [`LawHistory::encode`] is `h`.
-    fn decode(h: &NodeHistory) -> Self;
+    fn decode(h: &SiteHistory) -> Self;
 }

@@ -7,7 +7,7 @@
 //! a point's forces are traction × tributary area.
 
 use super::cone::ContactState;
-use super::history::{HistoryField, NodeHistory, PointHistory};
+use super::history::{HistoryField, SiteHistory, PointHistory};
 use crate::{Mat3, Vec2, Vec3};
 
 /// What the stepper and the contact solves need from an interface law besides its friction
@@ -80,7 +80,7 @@ pub trait Interface: std::fmt::Debug + Send + Sync {
 
     /// The frozen history at the start of a step of a point whose node history is `node`,
     /// in the point's local frame `frame` (rows t₁, t₂, n in global components).
-    fn point_history(&self, node: &NodeHistory, frame: &[[f64; 3]; 3]) -> PointHistory;
+    fn point_history(&self, node: &SiteHistory, frame: &[[f64; 3]; 3]) -> PointHistory;
 
     /// The node history to commit for a point that started the step with `start` and whose
     /// solution is `sol` (with the point history the step led to, [`PointSolution::history`]),
@@ -90,10 +90,10 @@ pub trait Interface: std::fmt::Debug + Send + Sync {
         start: &PointHistory,
         sol: &PointSolution,
         frame: &[[f64; 3]; 3],
-    ) -> NodeHistory;
+    ) -> SiteHistory;
 
     /// The history of a node that is no longer a contact candidate, from its last one.
-    fn release(&self, node: &NodeHistory) -> NodeHistory;
+    fn release(&self, node: &SiteHistory) -> SiteHistory;
 }
 
 /// Linear springs r̃ ≈ −K (x + e) approximating a point's bond at its frozen history, the warm

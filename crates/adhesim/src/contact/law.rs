@@ -18,7 +18,7 @@
 pub use super::anisotropic::Orthotropy;
 use super::anisotropic::{scale, unscale};
 use super::cone::{bipotential_trial, dry_projection};
-use super::history::{HistoryField, NodeHistory, PointHistory};
+use super::history::{HistoryField, SiteHistory, PointHistory};
 use super::interface::{
     AdhEval, AdhesiveResponse, FrozenSprings, Interface, PairScales, PointSolution,
 };
@@ -125,7 +125,7 @@ impl Interface for InterfaceLaw {
         self.bond.adhesive_response(start, dt, area, x)
     }
 
-    fn point_history(&self, node: &NodeHistory, frame: &[[f64; 3]; 3]) -> PointHistory {
+    fn point_history(&self, node: &SiteHistory, frame: &[[f64; 3]; 3]) -> PointHistory {
         self.bond.point_history(node, frame)
     }
 
@@ -134,11 +134,11 @@ impl Interface for InterfaceLaw {
         start: &PointHistory,
         sol: &PointSolution,
         frame: &[[f64; 3]; 3],
-    ) -> NodeHistory {
+    ) -> SiteHistory {
         self.bond.commit(start, sol, frame)
     }
 
-    fn release(&self, node: &NodeHistory) -> NodeHistory {
+    fn release(&self, node: &SiteHistory) -> SiteHistory {
         self.bond.release(node)
     }
 }

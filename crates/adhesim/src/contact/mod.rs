@@ -49,7 +49,7 @@ mod test_support;
 
 pub use cone::ContactState;
 pub use detect::{ContactPair, Master, RigidMotion, RigidShape};
-pub use history::{HistoryField, LawHistory, LawPointHistory, NodeHistory, PointHistory};
+pub use history::{HistoryField, LawHistory, LawPointHistory, SiteHistory, PointHistory};
 pub use interface::Interface;
 pub use law::InterfaceLaw;
 pub use rcc::RccHistory;

@@ -778,7 +778,7 @@ fn eig_sym3(a: &Mat3) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::history::{HistoryField, LawPointHistory, NodeHistory};
+    use crate::contact::history::{HistoryField, LawPointHistory, SiteHistory};
     use crate::contact::interface::AdhesiveResponse;
     use crate::contact::rcc::{adhesive_force, beta_update, BondState, RccParams};
     use crate::contact::test_support::*;
@@ -860,14 +860,14 @@ mod tests {
                 energy: e.energy,
             })
         }
-        fn point_history(&self, _: &NodeHistory, _: &[[f64; 3]; 3]) -> PointHistory {
+        fn point_history(&self, _: &SiteHistory, _: &[[f64; 3]; 3]) -> PointHistory {
             PointHistory::default()
         }
-        fn commit(&self, _: &PointHistory, _: &PointSolution, _: &[[f64; 3]; 3]) -> NodeHistory {
-            NodeHistory::default()
+        fn commit(&self, _: &PointHistory, _: &PointSolution, _: &[[f64; 3]; 3]) -> SiteHistory {
+            SiteHistory::default()
         }
-        fn release(&self, _: &NodeHistory) -> NodeHistory {
-            NodeHistory::default()
+        fn release(&self, _: &SiteHistory) -> SiteHistory {
+            SiteHistory::default()
         }
     }
 

@@ -24,7 +24,7 @@
 //!   detection distance are the caller's business: they carry `β = 0` (docs/model.md §5).
 
 use super::history::{
-    FieldKind, HistoryField, LawHistory, LawPointHistory, NodeHistory, PointHistory, Slot,
+    FieldKind, HistoryField, LawHistory, LawPointHistory, SiteHistory, PointHistory, Slot,
 };
 use super::interface::{
     AdhEval, AdhesiveResponse, FrozenSprings, Interface, PairScales, PointSolution,
@@ -80,15 +80,15 @@ impl LawHistory for RccHistory {
         },
     ];
 
-    fn encode(&self) -> NodeHistory {
-        let mut h = NodeHistory::default();
+    fn encode(&self) -> SiteHistory {
+        let mut h = SiteHistory::default();
         h.0[0] = self.beta;
         h.0[1..4].copy_from_slice(&self.ut);
         h.0[4] = self.damage;
         h
     }
 
-    fn decode(h: &NodeHistory) -> Self {
+    fn decode(h: &SiteHistory) -> Self {
         RccHistory {
             beta: h.0[0],
             ut: [h.0[1], h.0[2], h.0[3]],
@@ -97,8 +97,8 @@ impl LawHistory for RccHistory {
     }
 }
 
-impl From<&NodeHistory> for RccHistory {
-    fn from(h: &NodeHistory) -> Self {
+impl From<&SiteHistory> for RccHistory {
+    fn from(h: &SiteHistory) -> Self {
         RccHistory::decode(h)
     }
 }
@@ -199,7 +199,7 @@ impl Interface for Rcc {
             .map(|a| adhesive_response(a, BondState::decode(start), dt, area, x))
     }
 
-    fn point_history(&self, node: &NodeHistory, frame: &[[f64; 3]; 3]) -> PointHistory {
+    fn point_history(&self, node: &SiteHistory, frame: &[[f64; 3]; 3]) -> PointHistory {
         let h = RccHistory::decode(node);
         let ut = Vec3::from(h.ut);
         BondState {
@@ -217,7 +217,7 @@ impl Interface for Rcc {
         start: &PointHistory,
         sol: &PointSolution,
         frame: &[[f64; 3]; 3],
-    ) -> NodeHistory {
+    ) -> SiteHistory {
         let (start, end) = (BondState::decode(start), BondState::decode(&sol.history));
         let damage = match &self.0 {
             Some(a) => accumulated_damage(start.damage, start.beta, end.beta, a),
@@ -235,7 +235,7 @@ impl Interface for Rcc {
         .encode()
     }
 
-    fn release(&self, node: &NodeHistory) -> NodeHistory {
+    fn release(&self, node: &SiteHistory) -> SiteHistory {
         let h = RccHistory::decode(node);
         let damage = match &self.0 {
             Some(a) => accumulated_damage(h.damage, h.beta, 0.0, a),
