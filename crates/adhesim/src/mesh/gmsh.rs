@@ -930,42 +930,76 @@ impl MshFile {
     /// An unknown volume name, a selection without elements, a name used by physical groups
     /// of different dimensions, or a surface element that is not a face of any cell.
     pub fn body(&self, volumes: Option<&[String]>) -> Result<GmshBody, GmshError> {
+        self.check_selection(volumes)?;
+        self.check_group_dimensions()?;
+        let chosen = self.chosen_elements(volumes)?;
+        let (mut mesh, node_tags, new_id) = self.used_nodes(&chosen);
+        for &(v, e) in &chosen {
+            let conn = mesh.connectivity_mut(v.element);
+            conn.extend(v.element_nodes(e).iter().map(|&i| new_id[i]));
+        }
+        let cell_tags: Vec<u64> = chosen.iter().map(|&(v, e)| v.tags[e]).collect();
+        let cell_sets = self.volume_sets(&chosen, &mut mesh);
+        self.surface_sets(&new_id, &mut mesh)?;
+        self.low_dim_sets(&new_id, &mut mesh);
+        Ok(GmshBody {
+            mesh,
+            cell_tags,
+            node_tags,
+            cell_sets,
+        })
+    }
+
+    /// Checks that a selection of physical volumes is not empty and names only physical
+    /// volumes of the file.
+    fn check_selection(&self, volumes: Option<&[String]>) -> Result<(), GmshError> {
+        let Some(sel) = volumes else {
+            return Ok(());
+        };
         let available = self.physical_volumes();
-        if let Some(sel) = volumes {
-            if sel.is_empty() {
+        if sel.is_empty() {
+            return Err(self.err(format!(
+                "`volumes` is empty: name at least one physical volume ({})",
+                list(&available)
+            )));
+        }
+        for v in sel {
+            if !available.contains(v) {
                 return Err(self.err(format!(
-                    "`volumes` is empty: name at least one physical volume ({})",
+                    "{v:?} is not a physical volume of this file; its physical volumes are: {}",
                     list(&available)
                 )));
             }
-            for v in sel {
-                if !available.contains(v) {
+        }
+        Ok(())
+    }
+
+    /// Checks that no name stands for physical groups of different dimensions (they would
+    /// share a node set name).
+    fn check_group_dimensions(&self) -> Result<(), GmshError> {
+        let mut dims: BTreeMap<&str, i32> = BTreeMap::new();
+        for ((d, _), name) in &self.physical_names {
+            if let Some(d0) = dims.insert(name, *d) {
+                if d0 != *d {
                     return Err(self.err(format!(
-                        "{v:?} is not a physical volume of this file; its physical volumes are: {}",
-                        list(&available)
+                        "the name {name:?} is used by physical groups of dimension {d0} and {d}; give them distinct names (each becomes a node set)"
                     )));
                 }
             }
         }
+        Ok(())
+    }
+
+    /// The selected elements of each volume block, block after block: (block, element
+    /// index); at least one.
+    fn chosen_elements(
+        &self,
+        volumes: Option<&[String]>,
+    ) -> Result<Vec<(&VolumeElements, usize)>, GmshError> {
         let selected = |entity: i32| match volumes {
             None => true,
             Some(sel) => self.groups(3, entity).any(|g| sel.iter().any(|s| s == g)),
         };
-        // A name may not stand for groups of different dimensions (they would share a node
-        // set name).
-        {
-            let mut dims: BTreeMap<&str, i32> = BTreeMap::new();
-            for ((d, _), name) in &self.physical_names {
-                if let Some(d0) = dims.insert(name, *d) {
-                    if d0 != *d {
-                        return Err(self.err(format!(
-                            "the name {name:?} is used by physical groups of dimension {d0} and {d}; give them distinct names (each becomes a node set)"
-                        )));
-                    }
-                }
-            }
-        }
-        // The selected elements of each volume block: (block, element index).
         let chosen: Vec<(&VolumeElements, usize)> = self
             .volumes
             .iter()
@@ -985,7 +1019,13 @@ impl MshFile {
                 None => format!("the file holds no {} elements", volume_type_names(" or ")),
             }));
         }
-        // Keep the nodes the cells use, in file order.
+        Ok(chosen)
+    }
+
+    /// The nodes that the chosen cells use, in file order: a mesh holding them (no cells
+    /// yet), their Gmsh tags, and the new index of each file node (`usize::MAX` for a node
+    /// left out).
+    fn used_nodes(&self, chosen: &[(&VolumeElements, usize)]) -> (Mesh, Vec<u64>, Vec<usize>) {
         let mut new_id = vec![usize::MAX; self.nodes.len()];
         for &i in chosen.iter().flat_map(|&(v, e)| v.element_nodes(e)) {
             new_id[i] = 0;
@@ -999,13 +1039,16 @@ impl MshFile {
                 node_tags.push(self.node_tags[i]);
             }
         }
-        let map = |i: usize| new_id[i];
-        for &(v, e) in &chosen {
-            let conn = mesh.connectivity_mut(v.element);
-            conn.extend(v.element_nodes(e).iter().map(|&i| map(i)));
-        }
-        let cell_tags: Vec<u64> = chosen.iter().map(|&(v, e)| v.tags[e]).collect();
-        // Physical volumes: cell sets and node sets.
+        (mesh, node_tags, new_id)
+    }
+
+    /// Physical volumes: a node set of each in `mesh`; returns the cells of each (indices
+    /// in the order of `chosen`).
+    fn volume_sets(
+        &self,
+        chosen: &[(&VolumeElements, usize)],
+        mesh: &mut Mesh,
+    ) -> BTreeMap<String, Vec<usize>> {
         let mut cell_sets: BTreeMap<String, Vec<usize>> = BTreeMap::new();
         let entities = chosen.iter().map(|&(v, e)| v.entities[e]);
         for (c, entity) in entities.enumerate() {
@@ -1020,7 +1063,13 @@ impl MshFile {
                 .collect();
             mesh.set_nodes(name, nodes);
         }
-        // Physical surfaces: boundary faces re-oriented outward from their cell.
+        cell_sets
+    }
+
+    /// Physical surfaces: a face set of each in `mesh` (its boundary faces re-oriented
+    /// outward from their cell) and a node set of the nodes of all its faces; `new_id` maps
+    /// file nodes to mesh nodes.
+    fn surface_sets(&self, new_id: &[usize], mesh: &mut Mesh) -> Result<(), GmshError> {
         let owners = mesh.cell_faces();
         let mut faces: BTreeMap<String, (Vec<Face>, Vec<usize>)> = BTreeMap::new();
         let surface = self
@@ -1057,7 +1106,12 @@ impl MshFile {
             mesh.face_sets.insert(name.clone(), f);
             mesh.set_nodes(&name, nodes);
         }
-        // Physical curves and points: node sets.
+        Ok(())
+    }
+
+    /// Physical curves and points: a node set of each in `mesh`; `new_id` maps file nodes
+    /// to mesh nodes.
+    fn low_dim_sets(&self, new_id: &[usize], mesh: &mut Mesh) {
         let mut low: BTreeMap<String, Vec<usize>> = BTreeMap::new();
         for (dim, entity, nodes) in &self.low_dim {
             if nodes.iter().any(|&i| new_id[i] == usize::MAX) {
@@ -1072,12 +1126,6 @@ impl MshFile {
         for (name, nodes) in low {
             mesh.set_nodes(&name, nodes);
         }
-        Ok(GmshBody {
-            mesh,
-            cell_tags,
-            node_tags,
-            cell_sets,
-        })
     }
 }
 
