@@ -244,6 +244,8 @@ struct FileContact {
     orthotropy: Option<FileOrthotropy>,
     #[serde(default)]
     detection_distance: Option<f64>,
+    #[serde(default)]
+    discretisation: Option<String>,
 }
 
 #[derive(Deserialize, Debug)]

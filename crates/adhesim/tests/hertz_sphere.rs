@@ -296,6 +296,7 @@ fn indent_on(
             detection_distance: detection,
             slave_quads: vec![],
             thickness_twins: vec![],
+            discretisation: Default::default(),
         }],
     };
     let dofs = 3 * mesh.num_nodes();

@@ -8,7 +8,9 @@ use super::{FileSetRef, ScenarioError};
 use adhesim::contact::detect::{thickness_twins, tributary_areas};
 use adhesim::contact::law::Orthotropy;
 use adhesim::contact::rcc::DEFAULT_BETA_EPS;
-use adhesim::contact::{ContactPair, InterfaceLaw, Master, RccParams, RigidMotion, RigidShape};
+use adhesim::contact::{
+    ContactPair, InterfaceLaw, Master, PairDiscretisation, RccParams, RigidMotion, RigidShape,
+};
 use adhesim::mesh::Face;
 use std::collections::BTreeMap;
 
@@ -63,6 +65,7 @@ fn build_contact(
         None => None,
         Some(o) => Some(build_orthotropy(o, key, mu, &mut adhesion, ctx)?),
     };
+    let discretisation = build_discretisation(c, key, &master, ctx)?;
     let thickness_twins = slave.thickness_twins(c.master.body.as_deref(), bodies);
     let detection_distance = match c.detection_distance {
         Some(d) => ctx.positive(&format!("{key}.detection_distance"), d)?,
@@ -77,7 +80,37 @@ fn build_contact(
         detection_distance,
         slave_quads: slave.quads,
         thickness_twins,
+        discretisation,
     })
+}
+
+/// The pair's `discretisation` (node-to-surface when absent); mortar needs a deformable
+/// master.
+fn build_discretisation(
+    c: &FileContact,
+    key: &str,
+    master: &Master,
+    ctx: &Ctx,
+) -> Result<PairDiscretisation, ScenarioError> {
+    let Some(name) = c.discretisation.as_deref() else {
+        return Ok(PairDiscretisation::default());
+    };
+    let Some(&(_, d)) = PairDiscretisation::NAMES.iter().find(|(n, _)| *n == name) else {
+        let valid: Vec<String> = PairDiscretisation::NAMES
+            .iter()
+            .map(|(n, _)| format!("{n:?}"))
+            .collect();
+        return Err(ctx.err(format!(
+            "`{key}.discretisation` = {name:?}; valid values are {}",
+            valid.join(", ")
+        )));
+    };
+    if d == PairDiscretisation::Mortar && matches!(master, Master::Rigid { .. }) {
+        return Err(ctx.err(format!(
+            "`{key}.discretisation` = \"mortar\" needs a deformable master (`master.body` and `master.set`); against a rigid surface use \"node-to-surface\", which is exact there"
+        )));
+    }
+    Ok(d)
 }
 
 /// The slave side of a pair: a face set of one body and the nodes on it.

@@ -116,6 +116,8 @@ pub struct ContactPair {
     /// slab's thickness (same x and y), as indices into `slave_nodes`; empty lists for a 3D
     /// pair. Such a line is one contact point of the plane problem (see [`ContactPoint`]).
     pub thickness_twins: Vec<Vec<usize>>,
+    /// How the pair's contact sites are found (node-to-surface or mortar).
+    pub discretisation: super::discretisation::PairDiscretisation,
 }
 
 /// For a plane-strain slave surface (the plane being x-y): each node's twins, the other nodes
@@ -484,6 +486,24 @@ impl FaceGrid {
     pub(super) fn candidates(&self, x: [f64; 3]) -> &[usize] {
         let key = x.map(|v| (v / self.cell).floor() as i64);
         self.map.get(&key).map_or(&[], |v| v.as_slice())
+    }
+
+    /// The faces whose (inflated) boxes share a grid cell with the box [lo, hi] [m], each
+    /// once, in increasing order.
+    pub(super) fn candidates_in_box(&self, lo: [f64; 3], hi: [f64; 3]) -> Vec<usize> {
+        let a = lo.map(|v| (v / self.cell).floor() as i64);
+        let b = hi.map(|v| (v / self.cell).floor() as i64);
+        let mut out = Vec::new();
+        for x in a[0]..=b[0] {
+            for y in a[1]..=b[1] {
+                for z in a[2]..=b[2] {
+                    out.extend(self.map.get(&[x, y, z]).into_iter().flatten().copied());
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
     }
 }
 

@@ -2,15 +2,38 @@
 //! step. Every solver, output and checkpoint sees only the sites
 //! ([`super::detect::ContactPoint`]: signed node weights, a frame, an area and a constant gap
 //! part); a discretisation is one file that implements [`super::detect::Discretisation`]
-//! (node-to-surface: `node_to_surface`).
+//! (node-to-surface: `node_to_surface`; mortar: `mortar`).
 
 use super::detect::{ContactPair, ContactPoint, Discretisation};
+use super::mortar::Mortar;
 use super::node_to_surface::NodeToSurface;
 
+/// The discretisations a contact pair can have.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PairDiscretisation {
+    /// Each slave node projected on the master surface, with its tributary area.
+    #[default]
+    NodeToSurface,
+    /// Segment-to-segment: the conditions integrated over the slave faces' overlaps with the
+    /// master faces (deformable masters only).
+    Mortar,
+}
+
+impl PairDiscretisation {
+    /// The name the input uses for each, in the order of the variants.
+    pub const NAMES: [(&'static str, PairDiscretisation); 2] = [
+        ("node-to-surface", PairDiscretisation::NodeToSurface),
+        ("mortar", PairDiscretisation::Mortar),
+    ];
+}
+
 impl ContactPair {
-    /// The pair's discretisation (node-to-surface for every pair today).
+    /// The pair's discretisation.
     pub fn discretisation(&self) -> &dyn Discretisation {
-        &NodeToSurface
+        match self.discretisation {
+            PairDiscretisation::NodeToSurface => &NodeToSurface,
+            PairDiscretisation::Mortar => &Mortar,
+        }
     }
 }
 

@@ -5,7 +5,9 @@
 //!   gap, area and its stencil, the signed (node, weight) pairs of H), rigid master shapes,
 //!   tributary areas and the [`detect::Discretisation`] trait;
 //! - [`discretisation`]: the sites of every pair at the start of a step;
-//!   `node_to_surface`: single-pass node-to-surface detection, the first discretisation.
+//!   `node_to_surface`: single-pass node-to-surface detection, the first discretisation;
+//!   `mortar`: segment-to-segment contact between deformable bodies, the second, on the
+//!   plane geometry of [`polygon`] (clipping and quadrature).
 //!
 //! Laws (what happens at one site):
 //! - `cone`: Coulomb's cone and the bi-potential projection; [`anisotropic`]: the elliptic
@@ -35,10 +37,12 @@ pub mod history;
 pub mod interface;
 pub mod law;
 pub mod mixed;
+pub(crate) mod mortar;
 pub mod natural_map;
 pub mod newton;
 pub(crate) mod node_to_surface;
 pub mod point;
+pub mod polygon;
 pub mod rcc;
 pub mod reduced;
 pub mod registry;
@@ -49,6 +53,7 @@ mod test_support;
 
 pub use cone::ContactState;
 pub use detect::{ContactPair, Master, RigidMotion, RigidShape};
+pub use discretisation::PairDiscretisation;
 pub use history::{HistoryField, LawHistory, LawPointHistory, SiteHistory, PointHistory};
 pub use interface::Interface;
 pub use law::InterfaceLaw;

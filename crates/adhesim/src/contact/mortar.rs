@@ -1,0 +1,445 @@
+//! Mortar (segment-to-segment) contact between two deformable bodies: the contact
+//! conditions are integrated over the slave surface instead of being collocated at the slave
+//! nodes (docs/contact-surfaces.md).
+//!
+//! At the start of a step each slave face is laid on its own plane with the master faces
+//! that face it within the detection distance; the slave polygon is clipped by each master
+//! polygon, and each overlap (a segment) is integrated by a rule exact to degree 5, which is
+//! exact for the products of bilinear shape functions on parallelograms. Slave node j then
+//! holds
+//!
+//! - C_j = ∫ N_j dA over the covered part of its faces (the mortar measure),
+//! - M_jl = ∫ N_j N_l dA for each master node l,
+//!
+//! and one contact site: the slave node (weight 1) against the master nodes with weights
+//! M_jl / C_j. The slave side is lumped (the row sums of the slave mortar matrix), so a site
+//! stays one slave node, the master weights are positive and add up to 1, and a uniform
+//! pressure p gives the nodal forces p C_j on the slave side and p Σ_j M_jl on the master
+//! side: both are the consistent forces of that pressure, which is what passes the contact
+//! patch test on non-matching meshes. The site's area is C_j in the reference configuration
+//! (the covered measure scaled by each face's reference-to-current area ratio), so tractions
+//! stay nominal as with node-to-surface.
+
+use super::detect::{frame_from_normal, unit, ContactPair, ContactPoint, Discretisation, FaceGrid};
+use super::detect::Master;
+use super::polygon::{clip, counter_clockwise, polygon_quadrature, shape_at, Point2};
+use crate::mesh::Face;
+use crate::Vec3;
+use std::collections::BTreeMap;
+
+/// The mortar discretisation of a contact pair.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Mortar;
+
+impl Discretisation for Mortar {
+    fn sites(
+        &self,
+        pi: usize,
+        pair: &ContactPair,
+        reference: &[[f64; 3]],
+        u0: &[f64],
+        _t0: f64,
+        _t1: f64,
+    ) -> Vec<ContactPoint> {
+        // The input refuses a mortar pair on a rigid master.
+        let Master::Faces(faces) = &pair.master else {
+            return Vec::new();
+        };
+        let pos =
+            |n: usize| -> [f64; 3] { std::array::from_fn(|k| reference[n][k] + u0[3 * n + k]) };
+        let grid = FaceGrid::new(faces, &pos, pair.detection_distance);
+        let mut integrals = vec![NodeIntegrals::default(); pair.slave_nodes.len()];
+        for quad in &pair.slave_quads {
+            let face = SlaveFace::new(pair, quad, &pos, &|n| reference[n]);
+            face.integrate(faces, &grid, &pos, pair.detection_distance, &mut integrals);
+        }
+        let normals = slave_normals(pair, &pos);
+        let node_site = |li: usize| {
+            integrals[li].site(pi, pair, li, normals[li], &pos)
+        };
+        let mut out = Vec::new();
+        for li in 0..pair.slave_nodes.len() {
+            let twins = pair.thickness_twins.get(li).map_or(&[][..], |t| &t[..]);
+            if twins.is_empty() {
+                out.extend(node_site(li));
+                continue;
+            }
+            // The line's first node stands for it.
+            if twins.iter().any(|&j| j < li) {
+                continue;
+            }
+            let line: Vec<usize> = std::iter::once(li).chain(twins.iter().copied()).collect();
+            let found: Vec<Option<ContactPoint>> = line.iter().map(|&l| node_site(l)).collect();
+            if found.iter().all(Option::is_some) {
+                out.push(merge_line(pair, found.into_iter().flatten().collect()));
+            } else {
+                out.extend(found.into_iter().flatten());
+            }
+        }
+        out
+    }
+}
+
+/// What the segments give one slave node.
+#[derive(Clone, Debug, Default)]
+struct NodeIntegrals {
+    /// ∫ N_j dA over the covered part of the node's faces, current configuration [m²].
+    covered: f64,
+    /// ∫ N_j dA over the whole of the node's faces, current configuration [m²].
+    full: f64,
+    /// The covered measure in the reference configuration [m²].
+    nominal: f64,
+    /// ∫ N_j N_l dA for each master node l [m²].
+    master: BTreeMap<usize, f64>,
+}
+
+impl NodeIntegrals {
+    /// The node's contact site, if it is covered by the master surface and within the
+    /// detection distance of it.
+    fn site(
+        &self,
+        pi: usize,
+        pair: &ContactPair,
+        local: usize,
+        slave_normal: [f64; 3],
+        pos: &dyn Fn(usize) -> [f64; 3],
+    ) -> Option<ContactPoint> {
+        if !(self.covered > 1e-9 * self.full) {
+            return None;
+        }
+        let master: Vec<(usize, f64)> =
+            self.master.iter().map(|(&l, &m)| (l, m / self.covered)).collect();
+        let mut xm = [0.0; 3];
+        for &(l, w) in &master {
+            let x = pos(l);
+            (0..3).for_each(|k| xm[k] += w * x[k]);
+        }
+        let slave = pair.slave_nodes[local];
+        let d0: [f64; 3] = (Vec3::from(pos(slave)) - Vec3::from(xm)).into();
+        // N points from the master to the slave: against the slave's outward normal.
+        let normal = [-slave_normal[0], -slave_normal[1], -slave_normal[2]];
+        let gap = Vec3::from(d0).dot(&Vec3::from(normal));
+        if gap.abs() > pair.detection_distance {
+            return None;
+        }
+        Some(ContactPoint {
+            pair: pi,
+            local,
+            slave,
+            area: self.nominal,
+            frame: frame_from_normal(normal),
+            master,
+            master_point_end: xm,
+            d0,
+            twins: Vec::new(),
+        })
+    }
+}
+
+/// A slave face laid on its plane.
+struct SlaveFace {
+    /// Indices of its nodes in the pair (three or four).
+    locals: Vec<usize>,
+    /// Global indices of its nodes.
+    nodes: Vec<usize>,
+    /// Centre [m] and unit outward normal of its plane, with two in-plane axes.
+    centre: Vec3,
+    normal: Vec3,
+    axes: [Vec3; 2],
+    /// Its corners on the plane, in node order.
+    corners: Vec<Point2>,
+    /// Reference area over current area.
+    area_ratio: f64,
+}
+
+impl SlaveFace {
+    /// The slave face `quad` (indices into the pair's slave nodes; a triangle repeats its
+    /// last node) at the positions `pos`, with reference positions `reference`.
+    fn new(
+        pair: &ContactPair,
+        quad: &[usize; 4],
+        pos: &dyn Fn(usize) -> [f64; 3],
+        reference: &dyn Fn(usize) -> [f64; 3],
+    ) -> Self {
+        let locals: Vec<usize> = if quad[2] == quad[3] {
+            quad[..3].to_vec()
+        } else {
+            quad.to_vec()
+        };
+        let nodes: Vec<usize> = locals.iter().map(|&l| pair.slave_nodes[l]).collect();
+        let at = |f: &dyn Fn(usize) -> [f64; 3]| -> Vec<Vec3> {
+            nodes.iter().map(|&n| Vec3::from(f(n))).collect()
+        };
+        let (x, x_ref) = (at(pos), at(reference));
+        let area_vector = |p: &[Vec3]| match p.len() {
+            3 => 0.5 * (p[1] - p[0]).cross(&(p[2] - p[0])),
+            _ => 0.5 * (p[2] - p[0]).cross(&(p[3] - p[1])),
+        };
+        let (a, a_ref) = (area_vector(&x), area_vector(&x_ref));
+        let normal = unit(a);
+        let centre = x.iter().fold(Vec3::zeros(), |s, p| s + p) / x.len() as f64;
+        let frame = frame_from_normal(normal.into());
+        let axes = [Vec3::from(frame[0]), Vec3::from(frame[1])];
+        let corners = x
+            .iter()
+            .map(|p| [(p - centre).dot(&axes[0]), (p - centre).dot(&axes[1])])
+            .collect();
+        SlaveFace {
+            locals,
+            nodes,
+            centre,
+            normal,
+            axes,
+            corners,
+            area_ratio: a_ref.norm() / a.norm(),
+        }
+    }
+
+    /// A point of space on the face's plane.
+    fn project(&self, x: [f64; 3]) -> Point2 {
+        let d = Vec3::from(x) - self.centre;
+        [d.dot(&self.axes[0]), d.dot(&self.axes[1])]
+    }
+
+    /// Adds this face's segments with the master `faces` near it to the slave nodes'
+    /// integrals.
+    fn integrate(
+        &self,
+        faces: &[Face],
+        grid: &FaceGrid,
+        pos: &dyn Fn(usize) -> [f64; 3],
+        detection: f64,
+        integrals: &mut [NodeIntegrals],
+    ) {
+        let slave_polygon = counter_clockwise(self.corners.clone());
+        for (p, w) in polygon_quadrature(&slave_polygon) {
+            let n = shape_at(&self.corners, p);
+            for (i, &l) in self.locals.iter().enumerate() {
+                integrals[l].full += w * n[i];
+            }
+        }
+        let (lo, hi) = self.bounding_box(pos);
+        for fi in grid.candidates_in_box(lo, hi) {
+            let Some(master) = self.facing(&faces[fi], pos, detection) else {
+                continue;
+            };
+            let segment = clip(&slave_polygon, &counter_clockwise(master.clone()));
+            if segment.is_empty() {
+                continue;
+            }
+            let master_nodes = faces[fi].nodes();
+            for (p, w) in polygon_quadrature(&segment) {
+                let ns = shape_at(&self.corners, p);
+                let nm = shape_at(&master, p);
+                for (i, &l) in self.locals.iter().enumerate() {
+                    let node = &mut integrals[l];
+                    node.covered += w * ns[i];
+                    node.nominal += w * ns[i] * self.area_ratio;
+                    for (k, &m) in master_nodes.iter().enumerate() {
+                        *node.master.entry(m).or_insert(0.0) += w * ns[i] * nm[k];
+                    }
+                }
+            }
+        }
+    }
+
+    /// The corners of master face `face` on this face's plane, if it faces this face (its
+    /// normal against this one's) within `detection` [m] of its plane, and shares no node
+    /// with it.
+    fn facing(
+        &self,
+        face: &Face,
+        pos: &dyn Fn(usize) -> [f64; 3],
+        detection: f64,
+    ) -> Option<Vec<Point2>> {
+        let ns = face.nodes();
+        if ns.iter().any(|n| self.nodes.contains(n)) {
+            return None;
+        }
+        let x: Vec<Vec3> = ns.iter().map(|&n| Vec3::from(pos(n))).collect();
+        let a = match x.len() {
+            3 => (x[1] - x[0]).cross(&(x[2] - x[0])),
+            _ => (x[2] - x[0]).cross(&(x[3] - x[1])),
+        };
+        if !(a.dot(&self.normal) < 0.0) {
+            return None;
+        }
+        let height: Vec<f64> = x.iter().map(|p| (p - self.centre).dot(&self.normal)).collect();
+        let lowest = height.iter().copied().fold(f64::INFINITY, f64::min);
+        let highest = height.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        if lowest > detection || highest < -detection {
+            return None;
+        }
+        Some(ns.iter().map(|&n| self.project(pos(n))).collect())
+    }
+
+    /// The bounding box of the face's nodes [m].
+    fn bounding_box(&self, pos: &dyn Fn(usize) -> [f64; 3]) -> ([f64; 3], [f64; 3]) {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for &n in &self.nodes {
+            let p = pos(n);
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        (lo, hi)
+    }
+}
+
+/// The unit outward normal of the slave surface at each slave node: the mean of its faces'
+/// area vectors.
+fn slave_normals(pair: &ContactPair, pos: &dyn Fn(usize) -> [f64; 3]) -> Vec<[f64; 3]> {
+    let mut sum = vec![Vec3::zeros(); pair.slave_nodes.len()];
+    for q in &pair.slave_quads {
+        let x = q.map(|l| Vec3::from(pos(pair.slave_nodes[l])));
+        let a = if q[2] == q[3] {
+            (x[1] - x[0]).cross(&(x[2] - x[0]))
+        } else {
+            (x[2] - x[0]).cross(&(x[3] - x[1]))
+        };
+        let mut seen: Vec<usize> = Vec::with_capacity(4);
+        for &l in q {
+            if !seen.contains(&l) {
+                seen.push(l);
+                sum[l] += a;
+            }
+        }
+    }
+    sum.into_iter().map(|s| unit(s).into()).collect()
+}
+
+/// One site for the sites of the nodes of a line through a plane-strain slab: positions and
+/// master weights shared equally, the mean normal kept in the x-y plane, the areas together
+/// (as node-to-surface does, see [`ContactPoint::twins`]).
+fn merge_line(pair: &ContactPair, sites: Vec<ContactPoint>) -> ContactPoint {
+    let share = 1.0 / sites.len() as f64;
+    let mean = |f: &dyn Fn(&ContactPoint) -> [f64; 3]| -> [f64; 3] {
+        std::array::from_fn(|k| sites.iter().map(|p| share * f(p)[k]).sum())
+    };
+    let normal = Vec3::from(mean(&|p| p.frame[2]));
+    let in_plane = Vec3::new(normal[0], normal[1], 0.0);
+    let normal = if in_plane.norm() > 0.0 { unit(in_plane) } else { unit(normal) };
+    let mut master: BTreeMap<usize, f64> = BTreeMap::new();
+    for (m, w) in sites.iter().flat_map(|p| p.master.iter().copied()) {
+        *master.entry(m).or_insert(0.0) += share * w;
+    }
+    let first = &sites[0];
+    ContactPoint {
+        pair: first.pair,
+        local: first.local,
+        slave: first.slave,
+        area: sites.iter().map(|p| p.area).sum(),
+        frame: frame_from_normal(normal.into()),
+        master: master.into_iter().collect(),
+        master_point_end: mean(&|p| p.master_point_end),
+        d0: mean(&|p| p.d0),
+        twins: sites[1..]
+            .iter()
+            .map(|p| (pair.slave_nodes[p.local], p.local))
+            .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::InterfaceLaw;
+
+    /// A flat slave grid of nx × ny unit-less squares over [0, 1]² at height z (normal +z
+    /// or −z) and the pair against a master grid of mx × my faces at z = 0 (normal +z).
+    fn flat_pair(n: [usize; 2], m: [usize; 2], gap: f64) -> (ContactPair, Vec<[f64; 3]>) {
+        let mut coords = Vec::new();
+        let grid = |nx: usize, ny: usize, z: f64, coords: &mut Vec<[f64; 3]>| {
+            let base = coords.len();
+            for j in 0..=ny {
+                for i in 0..=nx {
+                    coords.push([i as f64 / nx as f64, j as f64 / ny as f64, z]);
+                }
+            }
+            let id = move |i: usize, j: usize| base + j * (nx + 1) + i;
+            (base, id)
+        };
+        let (mbase, mid) = grid(m[0], m[1], 0.0, &mut coords);
+        let master: Vec<Face> = (0..m[1])
+            .flat_map(|j| (0..m[0]).map(move |i| (i, j)))
+            .map(|(i, j)| Face::Quad([mid(i, j), mid(i + 1, j), mid(i + 1, j + 1), mid(i, j + 1)]))
+            .collect();
+        let _ = mbase;
+        let (sbase, sid) = grid(n[0], n[1], gap, &mut coords);
+        let slave_nodes: Vec<usize> = (sbase..coords.len()).collect();
+        // Slave faces turn clockwise seen from +z: their outward normal is −z.
+        let slave_quads: Vec<[usize; 4]> = (0..n[1])
+            .flat_map(|j| (0..n[0]).map(move |i| (i, j)))
+            .map(|(i, j)| {
+                [sid(i, j), sid(i, j + 1), sid(i + 1, j + 1), sid(i + 1, j)].map(|g| g - sbase)
+            })
+            .collect();
+        let pair = ContactPair {
+            name: "p".into(),
+            slave_area: vec![0.0; slave_nodes.len()],
+            slave_nodes,
+            master: Master::Faces(master),
+            law: InterfaceLaw::rcc(0.0, None, None),
+            detection_distance: 0.1,
+            slave_quads,
+            thickness_twins: Vec::new(),
+            discretisation: Default::default(),
+        };
+        (pair, coords)
+    }
+
+    #[test]
+    fn non_matching_flat_faces_give_consistent_measures_and_weights() {
+        for (n, m) in [([4, 4], [13, 13]), ([7, 5], [3, 4]), ([2, 3], [2, 3])] {
+            let (pair, coords) = flat_pair(n, m, 0.01);
+            let u0 = vec![0.0; 3 * coords.len()];
+            let sites = Mortar.sites(0, &pair, &coords, &u0, 0.0, 1.0);
+            assert_eq!(sites.len(), pair.slave_nodes.len());
+            // The measures add up to the slave surface's area, each being ∫ N_j (the
+            // corner, edge and interior shares of a uniform grid).
+            let total: f64 = sites.iter().map(|s| s.area).sum();
+            assert!((total - 1.0).abs() < 1e-13, "{total}");
+            let cell = 1.0 / (n[0] * n[1]) as f64;
+            for s in &sites {
+                let [x, y, _] = coords[s.slave];
+                let on_edge = |v: f64| v.abs() < 1e-12 || (v - 1.0).abs() < 1e-12;
+                let faces = [on_edge(x), on_edge(y)].iter().filter(|&&e| !e).count();
+                let expected = cell * [0.25, 0.5, 1.0][faces];
+                assert!((s.area - expected).abs() < 1e-14, "{} vs {expected}", s.area);
+                // Master weights: positive and a partition of unity, so the master point
+                // (the N_j-weighted mean of the covered master surface) lies on the flat
+                // master and the normal gap is exact; its tangential offset from the slave
+                // node is constant over the step and leaves the slip increments unchanged.
+                assert!(s.master.iter().all(|&(_, w)| w > 0.0));
+                assert!((s.master.iter().map(|m| m.1).sum::<f64>() - 1.0).abs() < 1e-13);
+                assert!(s.master_point_end[2].abs() < 1e-15);
+                assert!((s.d0[2] - 0.01).abs() < 1e-15 && s.frame[2][2] > 0.999_999);
+            }
+            // Each master node's share of a uniform pressure, Σ_j C_j w_jl, is ∫ N_l over
+            // the master surface.
+            let mut share = BTreeMap::new();
+            for s in &sites {
+                for &(l, w) in &s.master {
+                    *share.entry(l).or_insert(0.0) += s.area * w;
+                }
+            }
+            let mcell = 1.0 / (m[0] * m[1]) as f64;
+            for (&l, &a) in &share {
+                let [x, y, _] = coords[l];
+                let on_edge = |v: f64| v.abs() < 1e-12 || (v - 1.0).abs() < 1e-12;
+                let faces = [on_edge(x), on_edge(y)].iter().filter(|&&e| !e).count();
+                let expected = mcell * [0.25, 0.5, 1.0][faces];
+                assert!((a - expected).abs() < 1e-13, "master {l}: {a} vs {expected}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_slave_beyond_the_detection_distance_has_no_site() {
+        let (pair, coords) = flat_pair([3, 3], [4, 4], 0.2);
+        let u0 = vec![0.0; 3 * coords.len()];
+        assert!(Mortar.sites(0, &pair, &coords, &u0, 0.0, 1.0).is_empty());
+    }
+}
