@@ -27,7 +27,9 @@
 //! element size of a, and no node of the surface may penetrate the sphere.
 
 use adhesim::contact::detect::tributary_areas;
-use adhesim::contact::{ContactPair, InterfaceLaw, Master, RigidMotion, RigidShape};
+use adhesim::contact::{
+    ContactPair, InterfaceLaw, Master, PairDiscretisation, RigidMotion, RigidShape,
+};
 use adhesim::fbar::Formulation;
 use adhesim::material::{BlatzKo, Hyperelastic, UncoupledNeoHookean};
 use adhesim::mesh::{Face, Mesh};
@@ -569,4 +571,149 @@ fn hertz_on_a_nearly_incompressible_half_space_of_tetrahedra() {
         "the linear tetrahedron should lock: {:e}",
         linear.force
     );
+}
+
+/// The quarter half-space of [`graded_octant`] turned into the other body of a two-body
+/// Hertz contact: mirrored to y ≥ 0 (its cells and faces reordered to stay positively
+/// oriented), and each node column lifted by the gap profile p(r) = r²/2R (continued by its
+/// tangent beyond r = 10 a, so that the far cells are only sheared by a slope of 0.1), so
+/// that its face `top` (now facing down) is Hertz's paraboloid.
+fn paraboloid_octant(c: f64, k: usize, a: f64) -> Mesh {
+    let mut mesh = graded_octant(c, k, 1.0 + 1.0 / k as f64, EXTENT * a);
+    let r0 = 10.0 * a;
+    let profile = |r: f64| {
+        if r <= r0 {
+            r * r / (2.0 * R)
+        } else {
+            r0 * r0 / (2.0 * R) + (r - r0) * r0 / R
+        }
+    };
+    for x in &mut mesh.nodes {
+        x[1] = -x[1] + profile(x[0].hypot(x[2]));
+    }
+    for block in &mut mesh.blocks {
+        assert_eq!(block.element.nodes, 8, "the octant is made of hexahedra");
+        for cell in block.connectivity.chunks_exact_mut(8) {
+            let (lower, upper) = cell.split_at_mut(4);
+            lower.swap_with_slice(upper);
+        }
+    }
+    for faces in mesh.face_sets.values_mut() {
+        for f in faces.iter_mut() {
+            if let Face::Quad([a0, a1, a2, a3]) = *f {
+                *f = Face::Quad([a0, a3, a2, a1]);
+            }
+        }
+    }
+    mesh
+}
+
+/// Hertz between two soft bodies, on non-matching meshes with mortar contact: the
+/// paraboloid body of [`paraboloid_octant`] (h = a/4) pressed by D into the quarter
+/// half-space (h = a/4.7), both Blatz-Ko with G, so E* = E/(2(1 − ν²)) from the two. The
+/// paraboloid's far boundary moves down by D, the half-space's is clamped. Tolerance 3 %:
+/// the rigid-sphere test above reaches 1 % at these element sizes on one body; each
+/// truncated body adds ≈ +0.1 % and the two meshes' discretisation errors add up.
+/// Node-to-surface contact on the same meshes is printed beside it.
+#[test]
+fn hertz_between_two_soft_bodies_on_non_matching_mortar_meshes() {
+    let e_star = 2.5 * G / (2.0 * (1.0 - 0.25f64.powi(2)));
+    let f_hertz = 4.0 / 3.0 * e_star * R.sqrt() * D.powf(1.5);
+    let force = two_body_hertz(PairDiscretisation::Mortar);
+    let node_to_surface = two_body_hertz(PairDiscretisation::NodeToSurface);
+    eprintln!(
+        "Hertz {f_hertz:.5e} N; mortar {:+.2} %, node-to-surface {:+.2} %",
+        100.0 * (force / f_hertz - 1.0),
+        100.0 * (node_to_surface / f_hertz - 1.0)
+    );
+    assert!((force / f_hertz - 1.0).abs() < 0.03, "F = {force:e}, Hertz {f_hertz:e}");
+}
+
+/// The force [N] of the two-body indentation with the pair discretised by `discretisation`.
+fn two_body_hertz(discretisation: PairDiscretisation) -> f64 {
+    let a = (R * D).sqrt();
+    let c = 1.5 * a;
+    let lower = graded_octant(c, 7, 1.0 + 1.0 / 7.0, EXTENT * a);
+    let upper = paraboloid_octant(c, 6, a);
+    let off = lower.num_nodes();
+    let shift = |ns: &[usize]| ns.iter().map(|n| n + off).collect::<Vec<_>>();
+    let slave_nodes = shift(&upper.node_sets["top"]);
+    let slave_faces = &upper.face_sets["top"];
+    let local: HashMap<usize, usize> = upper.node_sets["top"]
+        .iter()
+        .enumerate()
+        .map(|(i, &n)| (n, i))
+        .collect();
+    let slave_quads: Vec<[usize; 4]> = slave_faces
+        .iter()
+        .map(|f| match *f {
+            Face::Quad(q) => q.map(|n| local[&n]),
+            Face::Tri([a0, a1, a2]) => [local[&a0], local[&a1], local[&a2], local[&a2]],
+        })
+        .collect();
+    let slave_area = tributary_areas(slave_faces, &upper.nodes, &upper.node_sets["top"]);
+    let master: Vec<Face> = lower.face_sets["top"].clone();
+    let body = |name: &str, mesh: &Mesh| Body {
+        name: name.into(),
+        mesh: mesh.clone(),
+        material: Arc::new(BlatzKo::new(G)),
+        density: 1000.0,
+        initial_velocity: [0.0; 3],
+        element: Formulation::Standard,
+        plane_strain: false,
+    };
+    let mut push = fixed(shift(&upper.node_sets["outer"]), [true, true, true]);
+    push.translation[1] = Table {
+        t: vec![0.0, 1.0],
+        v: vec![0.0, -D],
+    };
+    let problem = Problem {
+        name: "hertz-two-bodies".into(),
+        bodies: vec![body("half_space", &lower), body("paraboloid", &upper)],
+        dirichlet: vec![
+            fixed(lower.node_sets["sym_x"].clone(), [true, false, false]),
+            fixed(lower.node_sets["sym_z"].clone(), [false, false, true]),
+            fixed(lower.node_sets["outer"].clone(), [true, true, true]),
+            fixed(shift(&upper.node_sets["sym_x"]), [true, false, false]),
+            fixed(shift(&upper.node_sets["sym_z"]), [false, false, true]),
+            push,
+        ],
+        loads: vec![],
+        gravity: Default::default(),
+        time: TimeSettings {
+            t_end: 1.0,
+            dt: 1.0,
+            quasi_static: true,
+            contact_solver: ContactSolver::Semismooth,
+            ..TimeSettings::default()
+        },
+        contacts: vec![ContactPair {
+            name: "hertz".into(),
+            slave_nodes,
+            slave_area,
+            master: Master::Faces(master),
+            law: InterfaceLaw::rcc(0.0, None, None),
+            // Candidates: initial gap r²/2R < 1.5 d, i.e. r < 1.7 a.
+            detection_distance: 1.5 * D,
+            slave_quads,
+            thickness_twins: vec![],
+            discretisation,
+        }],
+    };
+    let clock = Instant::now();
+    let mut s = Stepper::new(Arc::new(problem)).expect("valid meshes");
+    let mut newton = 0;
+    while !s.finished() {
+        let rep = s.step().expect("the indentation step converges");
+        newton += rep.newton_iterations;
+    }
+    // The force on the paraboloid, four quarters.
+    let force = 4.0 * s.contact[0].iter().map(|c| c.force[1]).sum::<f64>();
+    eprintln!(
+        "two soft bodies, {discretisation:?}, h = a/4 on a/4.7: F = {force:.5e} N, \
+         {newton} Newton iterations, {} dofs, {:.1} s",
+        s.disc.num_dofs(),
+        clock.elapsed().as_secs_f64()
+    );
+    force
 }
