@@ -248,8 +248,8 @@ fn deformable_master(
 ) -> Result<Master, ScenarioError> {
     let m = &c.master;
     let mb = bodies.body(&format!("{key}.master.body"), body, ctx)?;
-    if mb == sb {
-        return Err(ctx.err(format!("`{key}`: slave and master are both on body {body:?}; self-contact is not supported, the master must be another body")));
+    if mb == sb && c.discretisation.as_deref() != Some("mortar") {
+        return Err(ctx.err(format!("`{key}`: slave and master are both on body {body:?}; self-contact needs `discretisation = \"mortar\"` (node-to-surface would find each slave node's own faces)")));
     }
     let set = m.set.as_deref().ok_or_else(|| {
         ctx.err(format!(

@@ -195,16 +195,26 @@ pub struct ContactPoint {
     /// among them, and its area is theirs together, so that the slab cannot be twisted out
     /// of its plane by contact.
     pub twins: Vec<(usize, usize)>,
+    /// The slave side's own weights (global node, weight; adding up to 1) when the point's
+    /// slave displacement is a weighted mean of several slave nodes (mortar); empty for the
+    /// node alone or with its twins.
+    pub slave_weights: Vec<(usize, f64)>,
 }
 
 impl ContactPoint {
     /// The slave nodes with their weights in the point's slave displacement: the node alone
-    /// (weight 1), or the node and its twins through a plane-strain slab (equal weights).
-    pub fn slave_nodes(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+    /// (weight 1), the node and its twins through a plane-strain slab (equal weights), or
+    /// [`ContactPoint::slave_weights`] when given.
+    pub fn slave_nodes(&self) -> Box<dyn Iterator<Item = (usize, f64)> + '_> {
+        if !self.slave_weights.is_empty() {
+            return Box::new(self.slave_weights.iter().copied());
+        }
         let w = self.node_share();
-        std::iter::once(self.slave)
-            .chain(self.twins.iter().map(|t| t.0))
-            .map(move |s| (s, w))
+        Box::new(
+            std::iter::once(self.slave)
+                .chain(self.twins.iter().map(|t| t.0))
+                .map(move |s| (s, w)),
+        )
     }
 
     /// The point's stencil: every node whose displacement enters its relative displacement,

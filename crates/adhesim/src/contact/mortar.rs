@@ -11,21 +11,28 @@
 //! - C_j = ∫ N_j dA over the covered part of its faces (the mortar measure),
 //! - M_jl = ∫ N_j N_l dA for each master node l,
 //!
-//! and one contact site: the slave node (weight 1) against the master nodes with weights
-//! M_jl / C_j. The slave side is lumped (the row sums of the slave mortar matrix), so a site
-//! stays one slave node, the master weights are positive and add up to 1, and a uniform
-//! pressure p gives the nodal forces p C_j on the slave side and p Σ_j M_jl on the master
-//! side: both are the consistent forces of that pressure, which is what passes the contact
-//! patch test on non-matching meshes. The site's area is C_j in the reference configuration
-//! (the covered measure scaled by each face's reference-to-current area ratio), so tractions
-//! stay nominal as with node-to-surface.
+//! and one contact site: the N_j-weighted mean of the slave surface (slave nodes k with
+//! weights D_jk / C_j, D_jk = ∫ N_j N_k dA over the covered part) against the N_j-weighted
+//! mean of the master surface (master nodes l with weights M_jl / C_j). Both sets of weights
+//! are positive and add up to 1, a uniform pressure p gives the nodal forces p ∫ N_k on the
+//! slave side and p ∫ N_l on the master side (the consistent forces of that pressure, which is
+//! what passes the contact patch test on non-matching meshes), and two surfaces that stretch
+//! together have no relative slip (the two means move alike). The site is keyed by its slave
+//! node j; its area is C_j in the reference configuration (the covered measure scaled by each
+//! face's reference-to-current area ratio), so tractions stay nominal as with node-to-surface.
+//!
+//! Self-contact is the same: the slave and master faces are of one body (one face set, or
+//! two); a face sharing a node with a slave face (its neighbour on the surface) is left out
+//! of its segments unless the surface folds back between them by more than 120° (the two
+//! lips of a slit at its tip); on one face set the overlap of two faces facing each other is
+//! integrated from one of them only.
 
 use super::detect::{frame_from_normal, unit, ContactPair, ContactPoint, Discretisation, FaceGrid};
 use super::detect::Master;
 use super::polygon::{clip, counter_clockwise, polygon_quadrature, shape_at, Point2};
 use crate::mesh::Face;
 use crate::Vec3;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashSet};
 
 /// The mortar discretisation of a contact pair.
 #[derive(Clone, Copy, Debug, Default)]
@@ -48,14 +55,15 @@ impl Discretisation for Mortar {
         let pos =
             |n: usize| -> [f64; 3] { std::array::from_fn(|k| reference[n][k] + u0[3 * n + k]) };
         let grid = FaceGrid::new(faces, &pos, pair.detection_distance);
+        let sides = Sides::new(pair, faces);
         let mut integrals = vec![NodeIntegrals::default(); pair.slave_nodes.len()];
         for quad in &pair.slave_quads {
             let face = SlaveFace::new(pair, quad, &pos, &|n| reference[n]);
-            face.integrate(faces, &grid, &pos, pair.detection_distance, &mut integrals);
+            face.integrate(faces, &grid, &sides, &pos, pair.detection_distance, &mut integrals);
         }
         let normals = slave_normals(pair, &pos);
         let node_site = |li: usize| {
-            integrals[li].site(pi, pair, li, normals[li], &pos)
+            normals[li].and_then(|n| integrals[li].site(pi, pair, li, n, &pos))
         };
         let mut out = Vec::new();
         for li in 0..pair.slave_nodes.len() {
@@ -80,6 +88,44 @@ impl Discretisation for Mortar {
     }
 }
 
+/// Which faces are on both sides of the pair: in self-contact on one face set, each face is
+/// a slave face and a master face, so that two faces facing each other would be integrated
+/// twice, once from each; only one of the two passes is kept (one pass, as between two
+/// bodies: redundant conditions would leave the contact solve without a unique answer).
+struct Sides {
+    /// The slave faces, by their sorted global nodes.
+    slave: HashSet<Vec<usize>>,
+    /// The master faces, by their sorted global nodes.
+    master: HashSet<Vec<usize>>,
+}
+
+impl Sides {
+    fn new(pair: &ContactPair, master: &[Face]) -> Self {
+        let slave = pair
+            .slave_quads
+            .iter()
+            .map(|q| key(q.iter().map(|&l| pair.slave_nodes[l])))
+            .collect();
+        let master = master.iter().map(|f| key(f.nodes().iter().copied())).collect();
+        Sides { slave, master }
+    }
+
+    /// Whether the overlap of slave face `slave` with master face `master` (both by their
+    /// sorted nodes) is integrated from this side: always, unless each is on both sides of
+    /// the pair, in which case from the face whose sorted nodes come first.
+    fn integrates(&self, slave: &[usize], master: &[usize]) -> bool {
+        !(self.master.contains(slave) && self.slave.contains(master)) || slave < master
+    }
+}
+
+/// A face's nodes sorted, without repeats (a triangle's repeated last node once).
+fn key(nodes: impl Iterator<Item = usize>) -> Vec<usize> {
+    let mut k: Vec<usize> = nodes.collect();
+    k.sort_unstable();
+    k.dedup();
+    k
+}
+
 /// What the segments give one slave node.
 #[derive(Clone, Debug, Default)]
 struct NodeIntegrals {
@@ -91,6 +137,8 @@ struct NodeIntegrals {
     nominal: f64,
     /// ∫ N_j N_l dA for each master node l [m²].
     master: BTreeMap<usize, f64>,
+    /// ∫ N_j N_k dA over the covered part for each slave node k (global) [m²].
+    slave: BTreeMap<usize, f64>,
 }
 
 impl NodeIntegrals {
@@ -107,15 +155,21 @@ impl NodeIntegrals {
         if !(self.covered > 1e-9 * self.full) {
             return None;
         }
-        let master: Vec<(usize, f64)> =
-            self.master.iter().map(|(&l, &m)| (l, m / self.covered)).collect();
-        let mut xm = [0.0; 3];
-        for &(l, w) in &master {
-            let x = pos(l);
-            (0..3).for_each(|k| xm[k] += w * x[k]);
-        }
+        let weights = |m: &BTreeMap<usize, f64>| -> Vec<(usize, f64)> {
+            m.iter().map(|(&n, &v)| (n, v / self.covered)).collect()
+        };
+        let (master, slave_weights) = (weights(&self.master), weights(&self.slave));
+        let mean = |w: &[(usize, f64)]| -> [f64; 3] {
+            let mut x = [0.0; 3];
+            for &(n, wn) in w {
+                let p = pos(n);
+                (0..3).for_each(|k| x[k] += wn * p[k]);
+            }
+            x
+        };
+        let (xs, xm) = (mean(&slave_weights), mean(&master));
         let slave = pair.slave_nodes[local];
-        let d0: [f64; 3] = (Vec3::from(pos(slave)) - Vec3::from(xm)).into();
+        let d0: [f64; 3] = (Vec3::from(xs) - Vec3::from(xm)).into();
         // N points from the master to the slave: against the slave's outward normal.
         let normal = [-slave_normal[0], -slave_normal[1], -slave_normal[2]];
         let gap = Vec3::from(d0).dot(&Vec3::from(normal));
@@ -132,6 +186,7 @@ impl NodeIntegrals {
             master_point_end: xm,
             d0,
             twins: Vec::new(),
+            slave_weights,
         })
     }
 }
@@ -207,10 +262,12 @@ impl SlaveFace {
         &self,
         faces: &[Face],
         grid: &FaceGrid,
+        sides: &Sides,
         pos: &dyn Fn(usize) -> [f64; 3],
         detection: f64,
         integrals: &mut [NodeIntegrals],
     ) {
+        let own = key(self.nodes.iter().copied());
         let slave_polygon = counter_clockwise(self.corners.clone());
         for (p, w) in polygon_quadrature(&slave_polygon) {
             let n = shape_at(&self.corners, p);
@@ -228,6 +285,9 @@ impl SlaveFace {
                 continue;
             }
             let master_nodes = faces[fi].nodes();
+            if !sides.integrates(&own, &key(master_nodes.iter().copied())) {
+                continue;
+            }
             for (p, w) in polygon_quadrature(&segment) {
                 let ns = shape_at(&self.corners, p);
                 let nm = shape_at(&master, p);
@@ -238,14 +298,18 @@ impl SlaveFace {
                     for (k, &m) in master_nodes.iter().enumerate() {
                         *node.master.entry(m).or_insert(0.0) += w * ns[i] * nm[k];
                     }
+                    for (k, &n) in self.nodes.iter().enumerate() {
+                        *node.slave.entry(n).or_insert(0.0) += w * ns[i] * ns[k];
+                    }
                 }
             }
         }
     }
 
     /// The corners of master face `face` on this face's plane, if it faces this face (its
-    /// normal against this one's) within `detection` [m] of its plane, and shares no node
-    /// with it.
+    /// normal against this one's) within `detection` [m] of its plane. A face sharing a node
+    /// with this one (its neighbour on a self-contact surface) must face it across a fold
+    /// sharper than 120°.
     fn facing(
         &self,
         face: &Face,
@@ -253,15 +317,16 @@ impl SlaveFace {
         detection: f64,
     ) -> Option<Vec<Point2>> {
         let ns = face.nodes();
-        if ns.iter().any(|n| self.nodes.contains(n)) {
-            return None;
-        }
         let x: Vec<Vec3> = ns.iter().map(|&n| Vec3::from(pos(n))).collect();
         let a = match x.len() {
             3 => (x[1] - x[0]).cross(&(x[2] - x[0])),
             _ => (x[2] - x[0]).cross(&(x[3] - x[1])),
         };
-        if !(a.dot(&self.normal) < 0.0) {
+        let facing = a.dot(&self.normal) / a.norm();
+        // A neighbour on the surface (a shared node) faces this face only across a fold
+        // sharper than 120°, as the two lips of a slit do at its tip.
+        let neighbour = ns.iter().any(|n| self.nodes.contains(n));
+        if !(facing < if neighbour { -0.5 } else { 0.0 }) {
             return None;
         }
         let height: Vec<f64> = x.iter().map(|p| (p - self.centre).dot(&self.normal)).collect();
@@ -289,9 +354,11 @@ impl SlaveFace {
 }
 
 /// The unit outward normal of the slave surface at each slave node: the mean of its faces'
-/// area vectors.
-fn slave_normals(pair: &ContactPair, pos: &dyn Fn(usize) -> [f64; 3]) -> Vec<[f64; 3]> {
-    let mut sum = vec![Vec3::zeros(); pair.slave_nodes.len()];
+/// area vectors; `None` where the surface folds back on itself at the node (the mean is less
+/// than half the faces' areas, as at the tip of a slit whose two lips are one face set),
+/// which then has no site of its own.
+fn slave_normals(pair: &ContactPair, pos: &dyn Fn(usize) -> [f64; 3]) -> Vec<Option<[f64; 3]>> {
+    let mut sum = vec![(Vec3::zeros(), 0.0); pair.slave_nodes.len()];
     for q in &pair.slave_quads {
         let x = q.map(|l| Vec3::from(pos(pair.slave_nodes[l])));
         let a = if q[2] == q[3] {
@@ -303,11 +370,14 @@ fn slave_normals(pair: &ContactPair, pos: &dyn Fn(usize) -> [f64; 3]) -> Vec<[f6
         for &l in q {
             if !seen.contains(&l) {
                 seen.push(l);
-                sum[l] += a;
+                sum[l].0 += a;
+                sum[l].1 += a.norm();
             }
         }
     }
-    sum.into_iter().map(|s| unit(s).into()).collect()
+    sum.into_iter()
+        .map(|(s, total)| (s.norm() >= 0.5 * total).then(|| unit(s).into()))
+        .collect()
 }
 
 /// One site for the sites of the nodes of a line through a plane-strain slab: positions and
@@ -321,10 +391,13 @@ fn merge_line(pair: &ContactPair, sites: Vec<ContactPoint>) -> ContactPoint {
     let normal = Vec3::from(mean(&|p| p.frame[2]));
     let in_plane = Vec3::new(normal[0], normal[1], 0.0);
     let normal = if in_plane.norm() > 0.0 { unit(in_plane) } else { unit(normal) };
-    let mut master: BTreeMap<usize, f64> = BTreeMap::new();
-    for (m, w) in sites.iter().flat_map(|p| p.master.iter().copied()) {
-        *master.entry(m).or_insert(0.0) += share * w;
-    }
+    let merged = |of: &dyn Fn(&ContactPoint) -> &[(usize, f64)]| -> Vec<(usize, f64)> {
+        let mut sum: BTreeMap<usize, f64> = BTreeMap::new();
+        for (n, w) in sites.iter().flat_map(|p| of(p).iter().copied()) {
+            *sum.entry(n).or_insert(0.0) += share * w;
+        }
+        sum.into_iter().collect()
+    };
     let first = &sites[0];
     ContactPoint {
         pair: first.pair,
@@ -332,13 +405,14 @@ fn merge_line(pair: &ContactPair, sites: Vec<ContactPoint>) -> ContactPoint {
         slave: first.slave,
         area: sites.iter().map(|p| p.area).sum(),
         frame: frame_from_normal(normal.into()),
-        master: master.into_iter().collect(),
+        master: merged(&|p| &p.master),
         master_point_end: mean(&|p| p.master_point_end),
         d0: mean(&|p| p.d0),
         twins: sites[1..]
             .iter()
             .map(|p| (pair.slave_nodes[p.local], p.local))
             .collect(),
+        slave_weights: merged(&|p| &p.slave_weights),
     }
 }
 

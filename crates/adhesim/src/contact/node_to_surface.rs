@@ -84,6 +84,7 @@ impl Projection {
             master_point_end: self.end,
             d0: (Vec3::from(self.slave) - Vec3::from(self.start)).into(),
             twins: Vec::new(),
+            slave_weights: Vec::new(),
         }
     }
 }
@@ -190,5 +191,6 @@ fn line_point(
             .iter()
             .map(|&l| (pair.slave_nodes[l], l))
             .collect(),
+        slave_weights: Vec::new(),
     }
 }
