@@ -41,6 +41,8 @@ pub struct SystemMatrix {
     chol: SparseCholesky,
     /// Symbolic analyses done since the start (1 for the element pattern).
     pub analyses: usize,
+    /// Numeric factorisations done since the start.
+    pub factorisations: usize,
 }
 
 impl SystemMatrix {
@@ -77,6 +79,7 @@ impl SystemMatrix {
             zero_positions,
             chol,
             analyses: 1,
+            factorisations: 0,
         })
     }
 
@@ -147,6 +150,7 @@ impl SystemMatrix {
     /// diagonal) and factorises.
     pub fn factorise(&mut self) -> Result<(), LinalgError> {
         self.apply_conditions();
+        self.factorisations += 1;
         self.chol.factorise(&self.values)
     }
 

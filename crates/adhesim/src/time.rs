@@ -124,6 +124,9 @@ pub struct StepReport {
     pub contact_points: usize,
     /// Delassus operators built in the step (0 when the last one could be reused).
     pub delassus_builds: usize,
+    /// Numeric factorisations of the step's matrix in the successful attempt (K̄, or, in the
+    /// semismooth contact solve, K̄ with the points' condensed blocks).
+    pub factorisations: usize,
     /// Wall time of the successful attempt, by phase [s].
     pub timings: PhaseTimes,
 }
@@ -514,6 +517,7 @@ impl Stepper {
                         contact_residual,
                         contact_points,
                         delassus_builds: a.delassus_builds,
+                        factorisations: a.factorisations,
                         timings,
                     });
                 }

@@ -38,6 +38,8 @@ pub struct NewtonLoop<'a> {
     pub model_size: f64,
     /// Wall time by phase.
     pub timings: PhaseTimes,
+    /// K̄'s factorisations when the attempt started.
+    factorisations0: usize,
     negligible: bool,
     last_relative: f64,
     contact_residual: f64,
@@ -57,6 +59,7 @@ impl<'a> NewtonLoop<'a> {
         model_size: f64,
     ) -> Self {
         NewtonLoop {
+            factorisations0: system.factorisations,
             step,
             coupling,
             system,
@@ -185,6 +188,7 @@ impl<'a> NewtonLoop<'a> {
             sweeps: self.coupling.sweeps(),
             contact_residual: self.contact_residual,
             delassus_builds: self.coupling.delassus_builds(),
+            factorisations: self.system.factorisations - self.factorisations0,
             timings: self.timings,
             reactions: check.reactions,
             points,
