@@ -176,6 +176,15 @@ impl<'a> ContactCoupling<'a> for NewtonCoupling<'a> {
         newton::add_contact_tangent(&self.sc.points, &stiffness, system);
     }
 
+    fn tangent_key(&self) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        for (pt, e) in self.sc.points.iter().zip(&self.evals) {
+            (pt.pair, pt.local, e.solution.state as u8).hash(&mut h);
+        }
+        h.finish()
+    }
+
     fn correct(
         &mut self,
         it: &Iterate,
