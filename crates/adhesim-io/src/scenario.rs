@@ -73,6 +73,7 @@ struct FileTime {
     rayleigh_beta: Option<f64>,
     contact_solver: Option<String>,
     contact_tol: Option<f64>,
+    newton: Option<String>,
 }
 
 #[derive(Deserialize, Debug)]

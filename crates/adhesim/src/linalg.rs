@@ -476,6 +476,11 @@ impl SparseCholesky {
         self.symbolic.len_val()
     }
 
+    /// Whether the last numeric factorisation succeeded (solves are then possible).
+    pub fn is_factorised(&self) -> bool {
+        self.factorised
+    }
+
     /// Numeric factorisation of the matrix with the analysed pattern and upper-triangle
     /// `values` (those at the dropped positions are not read).
     pub fn factorise(&mut self, values: &[f64]) -> Result<(), LinalgError> {

@@ -93,6 +93,23 @@ pub struct TimeSettings {
     /// Tolerance on the contact residual (natural map of the dry contact forces, relative to
     /// the step's force scale; docs/contact-solver.md).
     pub contact_tol: f64,
+    /// Whether Newton factorises K̄ at every iteration or keeps a factorisation while the
+    /// iterations converge (docs/scaling.md).
+    pub newton: NewtonMethod,
+}
+
+/// How the Newton iterations of a step use the factorisation of K̄.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum NewtonMethod {
+    /// A new factorisation for every Newton correction (and for every direction of the
+    /// semismooth contact solve).
+    #[default]
+    Full,
+    /// The Newton loop keeps its factorisation, within and across steps, while the
+    /// iterations contract with it ([`crate::time::factor_reuse`]), and factorises again
+    /// when they do not; a step that does not converge so is solved again with full Newton.
+    /// The semismooth contact solve factorises as under `Full`.
+    Modified,
 }
 
 /// How the contact conditions are solved in each Newton iteration (docs/contact-solver.md).
@@ -146,6 +163,7 @@ impl Default for TimeSettings {
             rayleigh: (0.0, 0.0),
             contact_solver: ContactSolver::Auto,
             contact_tol: 1e-8,
+            newton: NewtonMethod::Full,
         }
     }
 }

@@ -41,6 +41,11 @@ pub struct SystemMatrix {
     chol: SparseCholesky,
     /// Symbolic analyses done since the start (1 for the element pattern).
     pub analyses: usize,
+    /// Numeric factorisations done since the start.
+    pub factorisations: usize,
+    /// What the factorisation in use was made from, as its maker describes it (see
+    /// [`Self::factorise_keyed`]); None when unknown or when there is none.
+    factor_key: Option<u64>,
 }
 
 impl SystemMatrix {
@@ -77,6 +82,8 @@ impl SystemMatrix {
             zero_positions,
             chol,
             analyses: 1,
+            factorisations: 0,
+            factor_key: None,
         })
     }
 
@@ -101,6 +108,7 @@ impl SystemMatrix {
         self.pattern = ext;
         self.tied_to_ext = Some(map);
         self.analyses += 1;
+        self.factor_key = None;
         Ok(())
     }
 
@@ -147,7 +155,24 @@ impl SystemMatrix {
     /// diagonal) and factorises.
     pub fn factorise(&mut self) -> Result<(), LinalgError> {
         self.apply_conditions();
+        self.factor_key = None;
+        self.factorisations += 1;
         self.chol.factorise(&self.values)
+    }
+
+    /// [`Self::factorise`], recording `key` (a hash of what the caller built the matrix
+    /// from, e.g. the step size and the contact cases) so that a later caller can tell
+    /// whether the factor still fits ([`Self::factor_key`]).
+    pub fn factorise_keyed(&mut self, key: u64) -> Result<(), LinalgError> {
+        self.factorise()?;
+        self.factor_key = Some(key);
+        Ok(())
+    }
+
+    /// The key the factorisation in use was made with by [`Self::factorise_keyed`]; None
+    /// when there is no factorisation, or it was made otherwise.
+    pub fn factor_key(&self) -> Option<u64> {
+        self.factor_key.filter(|_| self.chol.is_factorised())
     }
 
     /// Applies the Dirichlet conditions and the ties to the values, as [`Self::factorise`]

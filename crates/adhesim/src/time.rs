@@ -11,6 +11,7 @@ mod attempt;
 mod constraints;
 mod coupling;
 mod delassus_coupling;
+pub mod factor_reuse;
 mod integrator;
 mod mixed_coupling;
 mod newton_coupling;
@@ -28,7 +29,7 @@ use crate::contact::history::PointHistory;
 use crate::contact::interface::{Interface, PointSolution};
 use crate::contact::mixed::MixedWorkspace;
 use crate::linalg::LinalgError;
-use crate::problem::{ContactSolver, Problem};
+use crate::problem::{ContactSolver, NewtonMethod, Problem};
 use crate::system::SystemMatrix;
 use attempt::Attempt;
 use coupling::{Candidates, ContactCoupling, StepContact};
@@ -124,6 +125,9 @@ pub struct StepReport {
     pub contact_points: usize,
     /// Delassus operators built in the step (0 when the last one could be reused).
     pub delassus_builds: usize,
+    /// Numeric factorisations of the step's matrix in the successful attempt (K̄, or, in the
+    /// semismooth contact solve, K̄ with the points' condensed blocks).
+    pub factorisations: usize,
     /// Wall time of the successful attempt, by phase [s].
     pub timings: PhaseTimes,
 }
@@ -475,7 +479,7 @@ impl Stepper {
             if remaining - dt < 1e-3 * dt {
                 dt = remaining;
             }
-            match self.attempt(dt) {
+            match self.attempt_with_fallback(dt) {
                 Ok(a) => {
                     self.commit_contact(&a.points, &a.solutions, &a.history0);
                     self.reactions = a.reactions;
@@ -514,6 +518,7 @@ impl Stepper {
                         contact_residual,
                         contact_points,
                         delassus_builds: a.delassus_builds,
+                        factorisations: a.factorisations,
                         timings,
                     });
                 }
@@ -623,11 +628,24 @@ impl Stepper {
             .collect()
     }
 
-    /// One Newton solve over [t, t+dt]; Err with the reason on failure. The stages follow
-    /// docs/model.md §3: detect the contact candidates, predict, then iterate (assemble,
-    /// evaluate the contact law, check, factorise and solve, solve the contact problem,
-    /// update) until the iterate converges.
-    fn attempt(&mut self, dt: f64) -> Result<Attempt, String> {
+    /// [`Self::attempt`] with the scenario's Newton method; when a modified-Newton attempt
+    /// fails, the same step is tried again with full Newton (a new factorisation at every
+    /// iteration) before the caller cuts Δt back, so that keeping factorisations never
+    /// fails a step full Newton solves.
+    fn attempt_with_fallback(&mut self, dt: f64) -> Result<Attempt, String> {
+        let method = self.problem.time.newton;
+        let first = self.attempt(dt, method);
+        if first.is_ok() || method == NewtonMethod::Full {
+            return first;
+        }
+        self.attempt(dt, NewtonMethod::Full)
+    }
+
+    /// One Newton solve over [t, t+dt] under `method`; Err with the reason on failure. The
+    /// stages follow docs/model.md §3: detect the contact candidates, predict, then iterate
+    /// (assemble, evaluate the contact law, check, factorise and solve, solve the contact
+    /// problem, update) until the iterate converges.
+    fn attempt(&mut self, dt: f64, method: NewtonMethod) -> Result<Attempt, String> {
         self.disc.begin_step(dt);
         let (settings, t1) = (&self.problem.time, self.state.t + dt);
         let f_ext1 = self.external_force(t1);
@@ -673,6 +691,7 @@ impl Stepper {
             ws,
             settings,
             self.model_size,
+            method,
         );
         newton.timings.delassus += detect_time;
         let mut u = newton.predict(t1);

@@ -642,6 +642,7 @@ pub fn history_columns(problem: &Problem, output: &OutputSettings) -> Vec<String
     c.push("contact_sweeps".into());
     c.push("contact_points".into());
     c.push("delassus_builds".into());
+    c.push("factorisations".into());
     c.push("contact_residual".into());
     for f in [
         "time_assembly",
@@ -1000,6 +1001,7 @@ impl Observer for HistoryObserver {
         row.push(r.contact_sweeps as f64);
         row.push(r.contact_points as f64);
         row.push(r.delassus_builds as f64);
+        row.push(r.factorisations as f64);
         row.push(r.contact_residual);
         let tm = &r.timings;
         row.extend_from_slice(&[tm.assembly, tm.factorisation, tm.delassus, tm.contact_solve]);

@@ -1,8 +1,8 @@
-//! The `[time]` table: the time span and step, the integrator, Newton's iteration, damping
-//! and the contact solver.
+//! The `[time]` table: the time span and step, the integrator, Newton's iteration (its
+//! tolerance, limit and use of the factorisation), damping and the contact solver.
 
 use super::{Ctx, FileTime, ScenarioError};
-use adhesim::problem::{ContactSolver, TimeSettings};
+use adhesim::problem::{ContactSolver, NewtonMethod, TimeSettings};
 
 /// The validated `[time]` table; keys left out take [`TimeSettings::default`]'s values.
 pub(super) fn validate_time(t: &FileTime, ctx: &Ctx) -> Result<TimeSettings, ScenarioError> {
@@ -12,6 +12,7 @@ pub(super) fn validate_time(t: &FileTime, ctx: &Ctx) -> Result<TimeSettings, Sce
     let quasi_static = quasi_static(t, ctx)?;
     let lumped_mass = lumped_mass(t, ctx)?;
     let (newton_tol, max_newton) = newton(t, &d, ctx)?;
+    let newton = newton_method(t, ctx)?;
     let rayleigh = rayleigh(t, ctx)?;
     let (contact_solver, contact_tol) = contact_solver(t, &d, ctx)?;
     Ok(TimeSettings {
@@ -27,6 +28,7 @@ pub(super) fn validate_time(t: &FileTime, ctx: &Ctx) -> Result<TimeSettings, Sce
         rayleigh,
         contact_solver,
         contact_tol,
+        newton,
     })
 }
 
@@ -103,6 +105,18 @@ fn newton(t: &FileTime, d: &TimeSettings, ctx: &Ctx) -> Result<(f64, usize), Sce
         1000,
     )?;
     Ok((newton_tol, max_newton))
+}
+
+/// Whether `time.newton` asks for a new factorisation at every iteration (`"full"`, the
+/// default) or keeps one while the iterations converge (`"modified"`).
+fn newton_method(t: &FileTime, ctx: &Ctx) -> Result<NewtonMethod, ScenarioError> {
+    match t.newton.as_deref() {
+        None | Some("full") => Ok(NewtonMethod::Full),
+        Some("modified") => Ok(NewtonMethod::Modified),
+        Some(m) => Err(ctx.err(format!(
+            "`time.newton` = {m:?}; valid values are \"full\" and \"modified\""
+        ))),
+    }
 }
 
 /// Rayleigh damping's mass factor α [1/s] and stiffness factor β [s], 0 when left out.

@@ -36,6 +36,8 @@ pub(super) struct Attempt {
     pub(super) sweeps: usize,
     pub(super) contact_residual: f64,
     pub(super) delassus_builds: usize,
+    /// Numeric factorisations of the system matrix in the attempt.
+    pub(super) factorisations: usize,
     pub(super) timings: PhaseTimes,
     pub(super) reactions: Vec<f64>,
 }

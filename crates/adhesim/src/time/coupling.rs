@@ -176,6 +176,12 @@ pub trait ContactCoupling<'a> {
     /// Adds the contact conditions' stiffness to K̄ (before its factorisation); nothing for
     /// the solves that keep K̄ as it is.
     fn add_tangent(&self, _system: &mut SystemMatrix) {}
+    /// What the stiffness [`Self::add_tangent`] adds depends on besides the points' geometry
+    /// (e.g. their contact cases), hashed: a kept factorisation of K̄ is only reused for the
+    /// same key (`time.newton = "modified"`). 0 for the solves that add none.
+    fn tangent_key(&self) -> u64 {
+        0
+    }
     /// Completes the Newton correction `du` solved from K̄ du = Hᵀr − G; for a coupling that
     /// [folds the momentum](Self::folds_momentum) in, `du` holds Hᵀr − G itself, K̄'s values
     /// are set but not factorised, and `correct` replaces `du` by the whole correction.

@@ -4,9 +4,10 @@
 use super::attempt::{Attempt, PhaseTimes};
 use super::constraints::Constraints;
 use super::coupling::{ContactCoupling, Evaluated, Iterate};
+use super::factor_reuse::{keep_for_correction, matrix_key};
 use super::integrator::{norm, ThetaStep, Workspace};
 use crate::assembly::{Assembled, Discretisation};
-use crate::problem::TimeSettings;
+use crate::problem::{NewtonMethod, TimeSettings};
 use crate::system::SystemMatrix;
 use std::time::Instant;
 
@@ -38,6 +39,12 @@ pub struct NewtonLoop<'a> {
     pub model_size: f64,
     /// Wall time by phase.
     pub timings: PhaseTimes,
+    /// Whether each correction gets a new factorisation or may keep the last one.
+    method: NewtonMethod,
+    /// ‖G − Hᵀr‖ of the last corrected iterate [N] (the contraction test of a kept factor).
+    last_norm: Option<f64>,
+    /// K̄'s factorisations when the attempt started.
+    factorisations0: usize,
     negligible: bool,
     last_relative: f64,
     contact_residual: f64,
@@ -55,8 +62,10 @@ impl<'a> NewtonLoop<'a> {
         ws: &'a mut Workspace,
         settings: &'a TimeSettings,
         model_size: f64,
+        method: NewtonMethod,
     ) -> Self {
         NewtonLoop {
+            factorisations0: system.factorisations,
             step,
             coupling,
             system,
@@ -66,6 +75,8 @@ impl<'a> NewtonLoop<'a> {
             settings,
             model_size,
             timings: PhaseTimes::default(),
+            method,
+            last_norm: None,
             negligible: false,
             last_relative: f64::NAN,
             contact_residual: 0.0,
@@ -112,7 +123,7 @@ impl<'a> NewtonLoop<'a> {
         let mut du = if self.coupling.folds_momentum() {
             self.out_of_balance(&asm.tangent)
         } else {
-            self.newton_correction(&asm.tangent, iter)?
+            self.newton_correction(&asm.tangent, iter, check.norm)?
         };
         let it = Iterate::new(iter, &self.ws.g, balance.potential);
         let (norm_g, scale) = (check.norm, check.scale);
@@ -142,14 +153,26 @@ impl<'a> NewtonLoop<'a> {
     /// stiffness) and the correction against the residual with the current contact forces
     /// Hᵀr. The Gauss-Seidel solve then adds K̄⁻¹Hᵀ(r − r_prev): at a converged iterate
     /// r = r_prev and G(u) = Hᵀr whatever W was used, so W may be reused from an earlier
-    /// iteration or step (it then only slows the convergence).
-    fn newton_correction(&mut self, tangent: &[f64], iter: usize) -> Result<Vec<f64>, String> {
+    /// iteration or step (it then only slows the convergence). Under modified Newton the
+    /// factorisation of an earlier iteration or step is kept while the out-of-balance force,
+    /// `norm` [N] here, contracts ([`keep_for_correction`]): the same argument holds for K̄.
+    fn newton_correction(
+        &mut self,
+        tangent: &[f64],
+        iter: usize,
+        norm: f64,
+    ) -> Result<Vec<f64>, String> {
         let clock = Instant::now();
-        self.system.set_from_base(&self.step.matrix_terms(tangent));
-        self.coupling.add_tangent(self.system);
-        self.system
-            .factorise()
-            .map_err(|e| format!("{e} (Newton iteration {iter})"))?;
+        let key = matrix_key(self.step.dt, self.coupling.tangent_key());
+        let (factor, last) = (self.system.factor_key(), self.last_norm);
+        if !keep_for_correction(self.method, factor, key, last, norm) {
+            self.system.set_from_base(&self.step.matrix_terms(tangent));
+            self.coupling.add_tangent(self.system);
+            self.system
+                .factorise_keyed(key)
+                .map_err(|e| format!("{e} (Newton iteration {iter})"))?;
+        }
+        self.last_norm = Some(norm);
         let force = self.coupling.contact_force();
         let mut du: Vec<f64> = force.iter().zip(&self.ws.g).map(|(r, g)| r - g).collect();
         self.system.solve_in_place(&mut du);
@@ -185,6 +208,7 @@ impl<'a> NewtonLoop<'a> {
             sweeps: self.coupling.sweeps(),
             contact_residual: self.contact_residual,
             delassus_builds: self.coupling.delassus_builds(),
+            factorisations: self.system.factorisations - self.factorisations0,
             timings: self.timings,
             reactions: check.reactions,
             points,
