@@ -179,10 +179,10 @@ impl<'a> ContactCoupling<'a> for NewtonCoupling<'a> {
     fn tangent_key(&self) -> u64 {
         use std::hash::{Hash, Hasher};
         let mut h = std::collections::hash_map::DefaultHasher::new();
-        // The point (its slave site and master nodes) and its case.
+        // The point (its site and the nodes of its stencil) and its case.
         for (pt, e) in self.sc.points.iter().zip(&self.evals) {
             (pt.pair, pt.local, e.solution.state as u8).hash(&mut h);
-            pt.master.iter().for_each(|&(m, _)| m.hash(&mut h));
+            pt.stencil().for_each(|(n, _)| n.hash(&mut h));
         }
         h.finish()
     }
