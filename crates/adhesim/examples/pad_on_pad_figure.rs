@@ -25,7 +25,11 @@ const POISSON: f64 = 0.3;
 /// The closed form's (pull distance [m], tensile force [N]) at interface opening `u` [m].
 fn closed_form(u: f64) -> (f64, f64) {
     let u_c = (W / CN).sqrt();
-    let traction = if u <= u_c { CN * u } else { W * W / (CN * u.powi(3)) };
+    let traction = if u <= u_c {
+        CN * u
+    } else {
+        W * W / (CN * u.powi(3))
+    };
     let force = AREA * traction;
     let stiffness = YOUNG / (1.0 - POISSON * POISSON) * AREA / HEIGHT;
     (u + force / stiffness, force)
@@ -47,8 +51,11 @@ fn main() {
     };
     let (ku, kf) = (col("lower.bottom.uy"), col("lower.bottom.Fy"));
     // The pull: the lower pad's bottom below its undeformed position, tension positive.
-    let pulled: Vec<(f64, f64)> =
-        rows.iter().filter(|r| r[ku] <= 0.0).map(|r| (-r[ku], -r[kf])).collect();
+    let pulled: Vec<(f64, f64)> = rows
+        .iter()
+        .filter(|r| r[ku] <= 0.0)
+        .map(|r| (-r[ku], -r[kf]))
+        .collect();
     let peak = pulled.iter().map(|p| p.1).fold(0.0, f64::max);
     let work: f64 = pulled
         .windows(2)
@@ -60,7 +67,10 @@ fn main() {
         W * AREA
     );
     let um = |p: &[(f64, f64)]| -> (Vec<f64>, Vec<f64>) {
-        (p.iter().map(|q| q.0 * 1e6).collect(), p.iter().map(|q| q.1 * 1e3).collect())
+        (
+            p.iter().map(|q| q.0 * 1e6).collect(),
+            p.iter().map(|q| q.1 * 1e3).collect(),
+        )
     };
     // Drawn up to 15 µm, where the force is 1 % of its peak.
     let end = 15e-6;
@@ -76,8 +86,16 @@ fn main() {
         x_label: "pull distance [µm]".into(),
         y_label: "tensile force [mN]".into(),
         series: vec![
-            Series { label: "mortar, 8 on 5 faces".into(), x, y },
-            Series { label: "closed form".into(), x: cx, y: cy },
+            Series {
+                label: "mortar, 8 on 5 faces".into(),
+                x,
+                y,
+            },
+            Series {
+                label: "closed form".into(),
+                x: cx,
+                y: cy,
+            },
         ],
     };
     draw_line_plot(Path::new(&args[0]), &plot).expect("figure written");

@@ -107,9 +107,15 @@ fn mortar_passes_the_contact_patch_test_on_non_matching_meshes() {
                 "mortar {slave}×{slave} on {master}×{master}, {solver}: pressure error \
                  {worst:.1e}, force {force:.10} N"
             );
-            assert!(worst < 1e-6, "{slave} on {master}, {solver}: pressure off by {worst:e}");
+            assert!(
+                worst < 1e-6,
+                "{slave} on {master}, {solver}: pressure off by {worst:e}"
+            );
             let force_error = (force - PRESSURE).abs() / PRESSURE;
-            assert!(force_error < 1e-8, "{slave} on {master}, {solver}: force {force}");
+            assert!(
+                force_error < 1e-8,
+                "{slave} on {master}, {solver}: force {force}"
+            );
         }
     }
 }
@@ -118,7 +124,9 @@ fn mortar_passes_the_contact_patch_test_on_non_matching_meshes() {
 fn node_to_surface_fails_it_where_the_meshes_do_not_match() {
     for (slave, master) in [(7, 10), (10, 7)] {
         let (worst, force) = patch(slave, master, "node-to-surface", "gauss-seidel");
-        eprintln!("node-to-surface {slave}×{slave} on {master}×{master}: {worst:.1e}, {force:.6} N");
+        eprintln!(
+            "node-to-surface {slave}×{slave} on {master}×{master}: {worst:.1e}, {force:.6} N"
+        );
         assert!(worst > 0.01, "{slave} on {master}: {worst}");
     }
     let (worst, force) = patch(10, 10, "node-to-surface", "gauss-seidel");

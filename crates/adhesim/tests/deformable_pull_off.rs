@@ -25,7 +25,10 @@ fn pull(tag: &str, overrides: &[&str]) -> Vec<(f64, f64)> {
         .join("../../scenarios/contact/pad-on-pad-pull-off.toml");
     let opts = LoadOptions {
         variant: None,
-        overrides: overrides.iter().map(|s| Override::parse(s).unwrap()).collect(),
+        overrides: overrides
+            .iter()
+            .map(|s| Override::parse(s).unwrap())
+            .collect(),
     };
     let problem = load_with(&path, &opts).unwrap_or_else(|e| panic!("{e}"));
     let out = std::env::temp_dir().join(format!("adhesim-test-pad-on-pad-{tag}"));
@@ -58,6 +61,12 @@ fn mortar_pads_pull_off_at_the_closed_form_peak_with_the_work_of_adhesion() {
     eprintln!(
         "peak {peak:.6e} N (closed form {peak_exact:.6e}), work {work:.6e} J (w A = {work_exact:.6e})"
     );
-    assert!((peak / peak_exact - 1.0).abs() < 0.01, "peak {peak} vs {peak_exact}");
-    assert!((work / work_exact - 1.0).abs() < 0.01, "work {work} vs {work_exact}");
+    assert!(
+        (peak / peak_exact - 1.0).abs() < 0.01,
+        "peak {peak} vs {peak_exact}"
+    );
+    assert!(
+        (work / work_exact - 1.0).abs() < 0.01,
+        "work {work} vs {work_exact}"
+    );
 }

@@ -626,7 +626,10 @@ fn hertz_between_two_soft_bodies_on_non_matching_mortar_meshes() {
         100.0 * (force / f_hertz - 1.0),
         100.0 * (node_to_surface / f_hertz - 1.0)
     );
-    assert!((force / f_hertz - 1.0).abs() < 0.03, "F = {force:e}, Hertz {f_hertz:e}");
+    assert!(
+        (force / f_hertz - 1.0).abs() < 0.03,
+        "F = {force:e}, Hertz {f_hertz:e}"
+    );
 }
 
 /// The force [N] of the two-body indentation with the pair discretised by `discretisation`.

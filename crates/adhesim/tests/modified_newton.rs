@@ -116,6 +116,9 @@ fn a_step_modified_newton_cannot_solve_falls_back_to_full_newton() {
     let (full, modified) = full_against_modified(&["mu=0", "time.max_newton=5"]);
     for (a, b) in full.iter().zip(&modified) {
         assert_eq!((a.cutbacks, b.cutbacks), (0, 0));
-        assert_eq!(b.factorisations, b.iterations, "{b:?}: solved by full Newton");
+        assert_eq!(
+            b.factorisations, b.iterations,
+            "{b:?}: solved by full Newton"
+        );
     }
 }

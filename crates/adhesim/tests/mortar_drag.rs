@@ -57,14 +57,29 @@ fn a_block_dragged_over_a_soft_block_slides_at_mu_times_the_normal_force() {
     assert_eq!(summary.outcome, Outcome::Finished);
     let (cols, rows) = adhesim_io::output::csv::read_history(out.join("history.csv")).unwrap();
     let col = |name: &str| cols.iter().position(|c| c == name).unwrap();
-    let (t, fx, fy, fn_) = (col("t"), col("upper.top.Fx"), col("upper.top.Fy"), col("interface.fy"));
+    let (t, fx, fy, fn_) = (
+        col("t"),
+        col("upper.top.Fx"),
+        col("upper.top.Fy"),
+        col("interface.fy"),
+    );
     let sliding: Vec<&Vec<f64>> = rows.iter().filter(|r| r[t] > 0.3).collect();
     assert!(sliding.len() > 30);
     for r in sliding {
         let ratio = r[fx] / -r[fy];
-        assert!((ratio / MU - 1.0).abs() < 0.01, "t = {}: Fx/Fy = {ratio}", r[t]);
+        assert!(
+            (ratio / MU - 1.0).abs() < 0.01,
+            "t = {}: Fx/Fy = {ratio}",
+            r[t]
+        );
         // What holds the top is what the interface carries on the slave block (Newton
         // tolerance 1e-10).
-        assert!((r[fn_] + r[fy]).abs() < 1e-6 * r[fn_], "t = {}: {} vs {}", r[t], r[fn_], r[fy]);
+        assert!(
+            (r[fn_] + r[fy]).abs() < 1e-6 * r[fn_],
+            "t = {}: {} vs {}",
+            r[t],
+            r[fn_],
+            r[fy]
+        );
     }
 }

@@ -57,16 +57,23 @@ fn slit_block() -> Mesh {
     let lips: Vec<Face> = mesh
         .boundary_faces()
         .into_iter()
-        .filter(|f| f.nodes().iter().all(|&n| (mesh.nodes[n][1] - SLIT_Y).abs() < 1e-9))
+        .filter(|f| {
+            f.nodes()
+                .iter()
+                .all(|&n| (mesh.nodes[n][1] - SLIT_Y).abs() < 1e-9)
+        })
         .collect();
-    let (upper, lower): (Vec<Face>, Vec<Face>) =
-        lips.into_iter().partition(|f| f.nodes().iter().any(|n| twin.values().any(|t| t == n)));
+    let (upper, lower): (Vec<Face>, Vec<Face>) = lips
+        .into_iter()
+        .partition(|f| f.nodes().iter().any(|n| twin.values().any(|t| t == n)));
     mesh.face_sets.clear();
     mesh.node_sets.clear();
     mesh.set_faces("lower_lip", lower);
     mesh.set_faces("upper_lip", upper);
     let select = |pred: &dyn Fn([f64; 3]) -> bool| -> Vec<usize> {
-        (0..mesh.nodes.len()).filter(|&n| pred(mesh.nodes[n])).collect()
+        (0..mesh.nodes.len())
+            .filter(|&n| pred(mesh.nodes[n]))
+            .collect()
     };
     let sets = [
         ("bottom", select(&|x| x[1].abs() < 1e-9)),
@@ -92,15 +99,22 @@ fn held(nodes: Vec<usize>, components: [bool; 3], uy: Table) -> Dirichlet {
 /// The self-contact pair of `slave` against `master` (face sets of `mesh`) with the law `law`.
 fn pair(mesh: &Mesh, slave: &[&str], master: &[&str], law: InterfaceLaw) -> ContactPair {
     let faces = |sets: &[&str]| -> Vec<Face> {
-        sets.iter().flat_map(|s| mesh.face_sets[*s].clone()).collect()
+        sets.iter()
+            .flat_map(|s| mesh.face_sets[*s].clone())
+            .collect()
     };
     let slave_faces = faces(slave);
-    let mut slave_nodes: Vec<usize> =
-        slave_faces.iter().flat_map(|f| f.nodes().to_vec()).collect();
+    let mut slave_nodes: Vec<usize> = slave_faces
+        .iter()
+        .flat_map(|f| f.nodes().to_vec())
+        .collect();
     slave_nodes.sort_unstable();
     slave_nodes.dedup();
-    let local: HashMap<usize, usize> =
-        slave_nodes.iter().enumerate().map(|(i, &n)| (n, i)).collect();
+    let local: HashMap<usize, usize> = slave_nodes
+        .iter()
+        .enumerate()
+        .map(|(i, &n)| (n, i))
+        .collect();
     let slave_quads = slave_faces
         .iter()
         .map(|f| match *f {
@@ -153,10 +167,22 @@ fn run_slit(
             plane_strain: false,
         }],
         dirichlet: vec![
-            held(mesh.node_sets["bottom"].clone(), [false, true, false], Table::constant(0.0)),
+            held(
+                mesh.node_sets["bottom"].clone(),
+                [false, true, false],
+                Table::constant(0.0),
+            ),
             held(mesh.node_sets["top"].clone(), [false, true, false], top),
-            held(mesh.node_sets["left"].clone(), [true, false, false], Table::constant(0.0)),
-            held(mesh.node_sets["back"].clone(), [false, false, true], Table::constant(0.0)),
+            held(
+                mesh.node_sets["left"].clone(),
+                [true, false, false],
+                Table::constant(0.0),
+            ),
+            held(
+                mesh.node_sets["back"].clone(),
+                [false, false, true],
+                Table::constant(0.0),
+            ),
         ],
         loads: vec![],
         gravity: Default::default(),
@@ -203,7 +229,10 @@ fn a_slit_block_carries_the_uncut_stress_across_its_lips_in_self_contact() {
     let exact = YOUNG * PUSH / HEIGHT * TOP_AREA;
     for (slave, master) in [
         (&["upper_lip"][..], &["lower_lip"][..]),
-        (&["lower_lip", "upper_lip"][..], &["lower_lip", "upper_lip"][..]),
+        (
+            &["lower_lip", "upper_lip"][..],
+            &["lower_lip", "upper_lip"][..],
+        ),
     ] {
         for solver in [ContactSolver::GaussSeidel, ContactSolver::Semismooth] {
             let (reaction, sites) = compress(slave, master, solver);

@@ -7,7 +7,7 @@
 //! a point's forces are traction × tributary area.
 
 use super::cone::ContactState;
-use super::history::{HistoryField, SiteHistory, PointHistory};
+use super::history::{HistoryField, PointHistory, SiteHistory};
 use crate::{Mat3, Vec2, Vec3};
 
 /// What the stepper and the contact solves need from an interface law besides its friction

@@ -18,7 +18,7 @@
 pub use super::anisotropic::Orthotropy;
 use super::anisotropic::{scale, unscale};
 use super::cone::{bipotential_trial, dry_projection};
-use super::history::{HistoryField, SiteHistory, PointHistory};
+use super::history::{HistoryField, PointHistory, SiteHistory};
 use super::interface::{
     AdhEval, AdhesiveResponse, FrozenSprings, Interface, PairScales, PointSolution,
 };

@@ -54,7 +54,7 @@ mod test_support;
 pub use cone::ContactState;
 pub use detect::{ContactPair, Master, RigidMotion, RigidShape};
 pub use discretisation::PairDiscretisation;
-pub use history::{HistoryField, LawHistory, LawPointHistory, SiteHistory, PointHistory};
+pub use history::{HistoryField, LawHistory, LawPointHistory, PointHistory, SiteHistory};
 pub use interface::Interface;
 pub use law::InterfaceLaw;
 pub use rcc::RccHistory;

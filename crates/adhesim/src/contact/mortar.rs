@@ -27,8 +27,8 @@
 //! lips of a slit at its tip); on one face set the overlap of two faces facing each other is
 //! integrated from one of them only.
 
-use super::detect::{frame_from_normal, unit, ContactPair, ContactPoint, Discretisation, FaceGrid};
 use super::detect::Master;
+use super::detect::{frame_from_normal, unit, ContactPair, ContactPoint, Discretisation, FaceGrid};
 use super::polygon::{clip, counter_clockwise, polygon_quadrature, shape_at, Point2};
 use crate::mesh::Face;
 use crate::Vec3;
@@ -59,12 +59,18 @@ impl Discretisation for Mortar {
         let mut integrals = vec![NodeIntegrals::default(); pair.slave_nodes.len()];
         for quad in &pair.slave_quads {
             let face = SlaveFace::new(pair, quad, &pos, &|n| reference[n]);
-            face.integrate(faces, &grid, &sides, &pos, pair.detection_distance, &mut integrals);
+            face.integrate(
+                faces,
+                &grid,
+                &sides,
+                &pos,
+                pair.detection_distance,
+                &mut integrals,
+            );
         }
         let normals = slave_normals(pair, &pos);
-        let node_site = |li: usize| {
-            normals[li].and_then(|n| integrals[li].site(pi, pair, li, n, &pos))
-        };
+        let node_site =
+            |li: usize| normals[li].and_then(|n| integrals[li].site(pi, pair, li, n, &pos));
         let mut out = Vec::new();
         for li in 0..pair.slave_nodes.len() {
             let twins = pair.thickness_twins.get(li).map_or(&[][..], |t| &t[..]);
@@ -106,7 +112,10 @@ impl Sides {
             .iter()
             .map(|q| key(q.iter().map(|&l| pair.slave_nodes[l])))
             .collect();
-        let master = master.iter().map(|f| key(f.nodes().iter().copied())).collect();
+        let master = master
+            .iter()
+            .map(|f| key(f.nodes().iter().copied()))
+            .collect();
         Sides { slave, master }
     }
 
@@ -329,7 +338,10 @@ impl SlaveFace {
         if !(facing < if neighbour { -0.5 } else { 0.0 }) {
             return None;
         }
-        let height: Vec<f64> = x.iter().map(|p| (p - self.centre).dot(&self.normal)).collect();
+        let height: Vec<f64> = x
+            .iter()
+            .map(|p| (p - self.centre).dot(&self.normal))
+            .collect();
         let lowest = height.iter().copied().fold(f64::INFINITY, f64::min);
         let highest = height.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         if lowest > detection || highest < -detection {
@@ -390,7 +402,11 @@ fn merge_line(pair: &ContactPair, sites: Vec<ContactPoint>) -> ContactPoint {
     };
     let normal = Vec3::from(mean(&|p| p.frame[2]));
     let in_plane = Vec3::new(normal[0], normal[1], 0.0);
-    let normal = if in_plane.norm() > 0.0 { unit(in_plane) } else { unit(normal) };
+    let normal = if in_plane.norm() > 0.0 {
+        unit(in_plane)
+    } else {
+        unit(normal)
+    };
     let merged = |of: &dyn Fn(&ContactPoint) -> &[(usize, f64)]| -> Vec<(usize, f64)> {
         let mut sum: BTreeMap<usize, f64> = BTreeMap::new();
         for (n, w) in sites.iter().flat_map(|p| of(p).iter().copied()) {
@@ -481,7 +497,11 @@ mod tests {
                 let on_edge = |v: f64| v.abs() < 1e-12 || (v - 1.0).abs() < 1e-12;
                 let faces = [on_edge(x), on_edge(y)].iter().filter(|&&e| !e).count();
                 let expected = cell * [0.25, 0.5, 1.0][faces];
-                assert!((s.area - expected).abs() < 1e-14, "{} vs {expected}", s.area);
+                assert!(
+                    (s.area - expected).abs() < 1e-14,
+                    "{} vs {expected}",
+                    s.area
+                );
                 // Master weights: positive and a partition of unity, so the master point
                 // (the N_j-weighted mean of the covered master surface) lies on the flat
                 // master and the normal gap is exact; its tangential offset from the slave
@@ -505,7 +525,10 @@ mod tests {
                 let on_edge = |v: f64| v.abs() < 1e-12 || (v - 1.0).abs() < 1e-12;
                 let faces = [on_edge(x), on_edge(y)].iter().filter(|&&e| !e).count();
                 let expected = mcell * [0.25, 0.5, 1.0][faces];
-                assert!((a - expected).abs() < 1e-13, "master {l}: {a} vs {expected}");
+                assert!(
+                    (a - expected).abs() < 1e-13,
+                    "master {l}: {a} vs {expected}"
+                );
             }
         }
     }

@@ -167,8 +167,10 @@ mod tests {
         for a in 0..=5u32 {
             for b in 0..=(5 - a) {
                 let exact = fact(a) * fact(b) / fact(a + b + 2);
-                let got: f64 =
-                    q.iter().map(|(p, w)| w * p[0].powi(a as i32) * p[1].powi(b as i32)).sum();
+                let got: f64 = q
+                    .iter()
+                    .map(|(p, w)| w * p[0].powi(a as i32) * p[1].powi(b as i32))
+                    .sum();
                 assert!((got - exact).abs() < 1e-15, "x^{a} y^{b}: {got} vs {exact}");
             }
         }

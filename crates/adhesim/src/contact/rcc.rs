@@ -24,7 +24,7 @@
 //!   detection distance are the caller's business: they carry `β = 0` (docs/model.md §5).
 
 use super::history::{
-    FieldKind, HistoryField, LawHistory, LawPointHistory, SiteHistory, PointHistory, Slot,
+    FieldKind, HistoryField, LawHistory, LawPointHistory, PointHistory, SiteHistory, Slot,
 };
 use super::interface::{
     AdhEval, AdhesiveResponse, FrozenSprings, Interface, PairScales, PointSolution,

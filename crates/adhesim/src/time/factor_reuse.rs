@@ -64,8 +64,20 @@ mod tests {
     #[test]
     fn full_newton_never_keeps_a_factor() {
         let k = matrix_key(0.1, 0);
-        assert!(!keep_for_correction(NewtonMethod::Full, Some(k), k, None, 0.0));
-        assert!(!keep_for_correction(NewtonMethod::Full, Some(k), k, Some(1.0), 1e-9));
+        assert!(!keep_for_correction(
+            NewtonMethod::Full,
+            Some(k),
+            k,
+            None,
+            0.0
+        ));
+        assert!(!keep_for_correction(
+            NewtonMethod::Full,
+            Some(k),
+            k,
+            Some(1.0),
+            1e-9
+        ));
     }
 
     #[test]
@@ -76,7 +88,19 @@ mod tests {
         assert!(keep_for_correction(m, Some(k), k, Some(1.0), 0.25));
         assert!(!keep_for_correction(m, Some(k), k, Some(1.0), 0.26));
         assert!(!keep_for_correction(m, None, k, Some(1.0), 0.1));
-        assert!(!keep_for_correction(m, Some(matrix_key(0.05, 7)), k, Some(1.0), 0.1));
-        assert!(!keep_for_correction(m, Some(matrix_key(0.1, 8)), k, Some(1.0), 0.1));
+        assert!(!keep_for_correction(
+            m,
+            Some(matrix_key(0.05, 7)),
+            k,
+            Some(1.0),
+            0.1
+        ));
+        assert!(!keep_for_correction(
+            m,
+            Some(matrix_key(0.1, 8)),
+            k,
+            Some(1.0),
+            0.1
+        ));
     }
 }
