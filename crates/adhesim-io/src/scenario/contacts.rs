@@ -50,7 +50,8 @@ fn build_contact(
         )));
     }
     let slave = Slave::build(&c.slave, key, bodies, ctx)?;
-    let master = build_master(c, key, slave.body, bodies, ctx)?;
+    let discretisation = build_discretisation(c, key, ctx)?;
+    let master = build_master(c, key, slave.body, discretisation, bodies, ctx)?;
     let mu = c.friction;
     if !(mu.is_finite() && mu >= 0.0) {
         return Err(ctx.err(format!(
@@ -65,7 +66,6 @@ fn build_contact(
         None => None,
         Some(o) => Some(build_orthotropy(o, key, mu, &mut adhesion, ctx)?),
     };
-    let discretisation = build_discretisation(c, key, &master, ctx)?;
     let thickness_twins = slave.thickness_twins(c.master.body.as_deref(), bodies);
     let detection_distance = match c.detection_distance {
         Some(d) => ctx.positive(&format!("{key}.detection_distance"), d)?,
@@ -84,12 +84,10 @@ fn build_contact(
     })
 }
 
-/// The pair's `discretisation` (node-to-surface when absent); mortar needs a deformable
-/// master.
+/// The pair's `discretisation` (node-to-surface when absent).
 fn build_discretisation(
     c: &FileContact,
     key: &str,
-    master: &Master,
     ctx: &Ctx,
 ) -> Result<PairDiscretisation, ScenarioError> {
     let Some(name) = c.discretisation.as_deref() else {
@@ -105,11 +103,6 @@ fn build_discretisation(
             valid.join(", ")
         )));
     };
-    if d == PairDiscretisation::Mortar && matches!(master, Master::Rigid { .. }) {
-        return Err(ctx.err(format!(
-            "`{key}.discretisation` = \"mortar\" needs a deformable master (`master.body` and `master.set`); against a rigid surface use \"node-to-surface\", which is exact there"
-        )));
-    }
     Ok(d)
 }
 
@@ -212,19 +205,25 @@ fn mean_edge(faces: &[Face], nodes: &[[f64; 3]]) -> f64 {
     sum / count.max(1) as f64
 }
 
-/// The master of the pair at `key`: a face set of a body other than the slave body `sb`,
-/// or a rigid shape with its motion.
+/// The master of the pair at `key` discretised by `d`: a face set of a body (the slave body
+/// `sb` itself with mortar only), or a rigid shape with its motion (not with mortar).
 fn build_master(
     c: &FileContact,
     key: &str,
     sb: usize,
+    d: PairDiscretisation,
     bodies: &Bodies,
     ctx: &Ctx,
 ) -> Result<Master, ScenarioError> {
     let m = &c.master;
     match (&m.body, &m.rigid) {
-        (Some(body), None) => deformable_master(c, body, key, sb, bodies, ctx),
+        (Some(body), None) => deformable_master(c, body, key, sb, d, bodies, ctx),
         (None, Some(kind)) => {
+            if d == PairDiscretisation::Mortar {
+                return Err(ctx.err(format!(
+                    "`{key}.discretisation` = \"mortar\" needs a deformable master (`master.body` and `master.set`); against a rigid surface use \"node-to-surface\", which is exact there"
+                )));
+            }
             if m.set.is_some() {
                 return Err(ctx.err(format!("`{key}.master.set` goes with `body`, not with `rigid`")));
             }
@@ -236,19 +235,20 @@ fn build_master(
     }
 }
 
-/// A deformable master: the face set `set` of body `body` (not the slave body `sb`), in
-/// global node indices.
+/// A deformable master: the face set `set` of body `body` (the slave body `sb` itself only
+/// with mortar, `d`), in global node indices.
 fn deformable_master(
     c: &FileContact,
     body: &str,
     key: &str,
     sb: usize,
+    d: PairDiscretisation,
     bodies: &Bodies,
     ctx: &Ctx,
 ) -> Result<Master, ScenarioError> {
     let m = &c.master;
     let mb = bodies.body(&format!("{key}.master.body"), body, ctx)?;
-    if mb == sb && c.discretisation.as_deref() != Some("mortar") {
+    if mb == sb && d != PairDiscretisation::Mortar {
         return Err(ctx.err(format!("`{key}`: slave and master are both on body {body:?}; self-contact needs `discretisation = \"mortar\"` (node-to-surface would find each slave node's own faces)")));
     }
     let set = m.set.as_deref().ok_or_else(|| {

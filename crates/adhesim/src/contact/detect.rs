@@ -5,6 +5,7 @@
 
 use super::anisotropic::aligned_frame;
 use super::law::InterfaceLaw;
+use super::polygon::quad_shape;
 use crate::mesh::Face;
 use crate::prescribed::{rotate, Rotation, Table};
 use crate::Vec3;
@@ -205,16 +206,14 @@ impl ContactPoint {
     /// The slave nodes with their weights in the point's slave displacement: the node alone
     /// (weight 1), the node and its twins through a plane-strain slab (equal weights), or
     /// [`ContactPoint::slave_weights`] when given.
-    pub fn slave_nodes(&self) -> Box<dyn Iterator<Item = (usize, f64)> + '_> {
-        if !self.slave_weights.is_empty() {
-            return Box::new(self.slave_weights.iter().copied());
-        }
+    pub fn slave_nodes(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let alone = self.slave_weights.is_empty();
         let w = self.node_share();
-        Box::new(
-            std::iter::once(self.slave)
-                .chain(self.twins.iter().map(|t| t.0))
-                .map(move |s| (s, w)),
-        )
+        let node_and_twins = std::iter::once(self.slave)
+            .chain(self.twins.iter().map(|t| t.0))
+            .filter(move |_| alone)
+            .map(move |s| (s, w));
+        self.slave_weights.iter().copied().chain(node_and_twins)
     }
 
     /// The point's stencil: every node whose displacement enters its relative displacement,
@@ -378,12 +377,7 @@ pub fn project_on_face(
             let p: [[f64; 3]; 4] = ns.map(pos);
             let (mut a, mut b) = (0.0f64, 0.0f64);
             let eval = |a: f64, b: f64| {
-                let w = [
-                    0.25 * (1.0 - a) * (1.0 - b),
-                    0.25 * (1.0 + a) * (1.0 - b),
-                    0.25 * (1.0 + a) * (1.0 + b),
-                    0.25 * (1.0 - a) * (1.0 + b),
-                ];
+                let w = quad_shape(a, b);
                 let da = [
                     -0.25 * (1.0 - b),
                     0.25 * (1.0 - b),

@@ -235,11 +235,7 @@ impl SlaveFace {
             nodes.iter().map(|&n| Vec3::from(f(n))).collect()
         };
         let (x, x_ref) = (at(pos), at(reference));
-        let area_vector = |p: &[Vec3]| match p.len() {
-            3 => 0.5 * (p[1] - p[0]).cross(&(p[2] - p[0])),
-            _ => 0.5 * (p[2] - p[0]).cross(&(p[3] - p[1])),
-        };
-        let (a, a_ref) = (area_vector(&x), area_vector(&x_ref));
+        let (a, a_ref) = (twice_area_vector(&x), twice_area_vector(&x_ref));
         let normal = unit(a);
         let centre = x.iter().fold(Vec3::zeros(), |s, p| s + p) / x.len() as f64;
         let frame = frame_from_normal(normal.into());
@@ -289,12 +285,12 @@ impl SlaveFace {
             let Some(master) = self.facing(&faces[fi], pos, detection) else {
                 continue;
             };
-            let segment = clip(&slave_polygon, &counter_clockwise(master.clone()));
-            if segment.is_empty() {
-                continue;
-            }
             let master_nodes = faces[fi].nodes();
             if !sides.integrates(&own, &key(master_nodes.iter().copied())) {
+                continue;
+            }
+            let segment = clip(&slave_polygon, &counter_clockwise(master.clone()));
+            if segment.is_empty() {
                 continue;
             }
             for (p, w) in polygon_quadrature(&segment) {
@@ -327,10 +323,7 @@ impl SlaveFace {
     ) -> Option<Vec<Point2>> {
         let ns = face.nodes();
         let x: Vec<Vec3> = ns.iter().map(|&n| Vec3::from(pos(n))).collect();
-        let a = match x.len() {
-            3 => (x[1] - x[0]).cross(&(x[2] - x[0])),
-            _ => (x[2] - x[0]).cross(&(x[3] - x[1])),
-        };
+        let a = twice_area_vector(&x);
         let facing = a.dot(&self.normal) / a.norm();
         // A neighbour on the surface (a shared node) faces this face only across a fold
         // sharper than 120°, as the two lips of a slit do at its tip.
@@ -365,6 +358,15 @@ impl SlaveFace {
     }
 }
 
+/// Twice the area vector of a face with corners `x` (three or four): the cross product of
+/// a triangle's edges or of a quadrilateral's diagonals [m²].
+fn twice_area_vector(x: &[Vec3]) -> Vec3 {
+    match x.len() {
+        3 => (x[1] - x[0]).cross(&(x[2] - x[0])),
+        _ => (x[2] - x[0]).cross(&(x[3] - x[1])),
+    }
+}
+
 /// The unit outward normal of the slave surface at each slave node: the mean of its faces'
 /// area vectors; `None` where the surface folds back on itself at the node (the mean is less
 /// than half the faces' areas, as at the tip of a slit whose two lips are one face set),
@@ -372,12 +374,12 @@ impl SlaveFace {
 fn slave_normals(pair: &ContactPair, pos: &dyn Fn(usize) -> [f64; 3]) -> Vec<Option<[f64; 3]>> {
     let mut sum = vec![(Vec3::zeros(), 0.0); pair.slave_nodes.len()];
     for q in &pair.slave_quads {
-        let x = q.map(|l| Vec3::from(pos(pair.slave_nodes[l])));
-        let a = if q[2] == q[3] {
-            (x[1] - x[0]).cross(&(x[2] - x[0]))
-        } else {
-            (x[2] - x[0]).cross(&(x[3] - x[1]))
-        };
+        let corners = if q[2] == q[3] { &q[..3] } else { &q[..] };
+        let x: Vec<Vec3> = corners
+            .iter()
+            .map(|&l| Vec3::from(pos(pair.slave_nodes[l])))
+            .collect();
+        let a = twice_area_vector(&x);
         let mut seen: Vec<usize> = Vec::with_capacity(4);
         for &l in q {
             if !seen.contains(&l) {
