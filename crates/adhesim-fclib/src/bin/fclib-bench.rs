@@ -127,6 +127,7 @@ fn nsgs_dense(p: &ReducedProblem, del: &Delassus, tol: f64, max_iter: usize) -> 
             master_point_end: [0.0; 3],
             d0: [0.0; 3],
             twins: Vec::new(),
+            slave_weights: Vec::new(),
         })
         .collect();
     let laws: Vec<InterfaceLaw> = p.mu.iter().map(|&mu| InterfaceLaw::coulomb(mu)).collect();
