@@ -143,16 +143,48 @@ pub fn cantilever_beam(
     nu: f64,
     section: Section,
 ) -> f64 {
+    let cells = if tets { Cells::Tet4 } else { Cells::Hex8 };
+    cantilever_beam_of(ny, cells, element, nu, section)
+}
+
+/// The cells of a structured test mesh.
+#[derive(Clone, Copy, Debug)]
+pub enum Cells {
+    /// The generator's hexahedra.
+    Hex8,
+    /// Each hexahedron split into six tetrahedra.
+    Tet4,
+    /// The tetrahedra with a node at the middle of each edge.
+    Tet10,
+}
+
+impl Cells {
+    /// The block `size` [m] with `divisions` hexahedra per direction, in these cells.
+    pub fn block(self, size: [f64; 3], divisions: [usize; 3]) -> Mesh {
+        let hexes = generate::block(size, divisions);
+        match self {
+            Cells::Hex8 => hexes,
+            Cells::Tet4 => hexes.split_hexes_into_tets(),
+            Cells::Tet10 => hexes.with_mid_side_nodes(),
+        }
+    }
+}
+
+/// [`cantilever_beam`] in the cells `cells`.
+pub fn cantilever_beam_of(
+    ny: usize,
+    cells: Cells,
+    element: Formulation,
+    nu: f64,
+    section: Section,
+) -> f64 {
     let (l, h, e) = (1.0, 0.1, 1.0e6);
     // Plane strain bends with E′ = E/(1 − ν²).
     let (depth, nz, plane_strain_factor) = match section {
         Section::PlaneStrain { nu_load } => (h / ny as f64, 1, 1.0 - nu_load * nu_load),
         Section::Square => (h, ny, 1.0),
     };
-    let mut mesh = generate::block([l, h, depth], [10 * ny, ny, nz]);
-    if tets {
-        mesh = mesh.split_hexes_into_tets();
-    }
+    let mesh = cells.block([l, h, depth], [10 * ny, ny, nz]);
     let material = UncoupledNeoHookean::from_young_poisson(e, nu);
     let mut p = one_body(
         mesh.clone(),

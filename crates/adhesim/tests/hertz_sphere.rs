@@ -26,7 +26,7 @@
 //! The contact radius (outermost node with a positive normal force) must be within one
 //! element size of a, and no node of the surface may penetrate the sphere.
 
-use adhesim::contact::detect::tributary_areas;
+use adhesim::contact::detect::{flat_quads, local_faces, tributary_areas};
 use adhesim::contact::{
     ContactPair, InterfaceLaw, Master, PairDiscretisation, RigidMotion, RigidShape,
 };
@@ -297,6 +297,7 @@ fn indent_on(
             // The no-penetration check below covers every surface node, candidate or not.
             detection_distance: detection,
             slave_quads: vec![],
+            slave_faces: vec![],
             thickness_twins: vec![],
             discretisation: Default::default(),
         }],
@@ -642,18 +643,7 @@ fn two_body_hertz(discretisation: PairDiscretisation) -> f64 {
     let shift = |ns: &[usize]| ns.iter().map(|n| n + off).collect::<Vec<_>>();
     let slave_nodes = shift(&upper.node_sets["top"]);
     let slave_faces = &upper.face_sets["top"];
-    let local: HashMap<usize, usize> = upper.node_sets["top"]
-        .iter()
-        .enumerate()
-        .map(|(i, &n)| (n, i))
-        .collect();
-    let slave_quads: Vec<[usize; 4]> = slave_faces
-        .iter()
-        .map(|f| match *f {
-            Face::Quad(q) => q.map(|n| local[&n]),
-            Face::Tri([a0, a1, a2]) => [local[&a0], local[&a1], local[&a2], local[&a2]],
-        })
-        .collect();
+    let local = local_faces(slave_faces, &upper.node_sets["top"]);
     let slave_area = tributary_areas(slave_faces, &upper.nodes, &upper.node_sets["top"]);
     let master: Vec<Face> = lower.face_sets["top"].clone();
     let body = |name: &str, mesh: &Mesh| Body {
@@ -698,7 +688,8 @@ fn two_body_hertz(discretisation: PairDiscretisation) -> f64 {
             law: InterfaceLaw::rcc(0.0, None, None),
             // Candidates: initial gap r²/2R < 1.5 d, i.e. r < 1.7 a.
             detection_distance: 1.5 * D,
-            slave_quads,
+            slave_quads: flat_quads(&local),
+            slave_faces: local,
             thickness_twins: vec![],
             discretisation,
         }],

@@ -10,7 +10,7 @@
 //! are run: one face set holding both lips (each overlap integrated from both sides, half
 //! each), and two face sets, one lip against the other.
 
-use adhesim::contact::detect::tributary_areas;
+use adhesim::contact::detect::{flat_quads, local_faces, tributary_areas};
 use adhesim::contact::{ContactPair, InterfaceLaw, Master, PairDiscretisation};
 use adhesim::material::LinearElastic;
 use adhesim::mesh::{generate, Face, Mesh};
@@ -110,18 +110,7 @@ fn pair(mesh: &Mesh, slave: &[&str], master: &[&str], law: InterfaceLaw) -> Cont
         .collect();
     slave_nodes.sort_unstable();
     slave_nodes.dedup();
-    let local: HashMap<usize, usize> = slave_nodes
-        .iter()
-        .enumerate()
-        .map(|(i, &n)| (n, i))
-        .collect();
-    let slave_quads = slave_faces
-        .iter()
-        .map(|f| match *f {
-            Face::Quad(q) => q.map(|n| local[&n]),
-            Face::Tri([a, b, c]) => [local[&a], local[&b], local[&c], local[&c]],
-        })
-        .collect();
+    let local = local_faces(&slave_faces, &slave_nodes);
     ContactPair {
         name: "lips".into(),
         slave_area: tributary_areas(&slave_faces, &mesh.nodes, &slave_nodes),
@@ -129,7 +118,8 @@ fn pair(mesh: &Mesh, slave: &[&str], master: &[&str], law: InterfaceLaw) -> Cont
         master: Master::Faces(faces(master)),
         law,
         detection_distance: 0.05,
-        slave_quads,
+        slave_quads: flat_quads(&local),
+        slave_faces: local,
         thickness_twins: vec![],
         discretisation: PairDiscretisation::Mortar,
     }

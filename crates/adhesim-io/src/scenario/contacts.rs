@@ -5,14 +5,13 @@ use super::bodies::Bodies;
 use super::boundaries::{build_components, build_rotation, zero_tables};
 use super::{Ctx, FileAdhesion, FileContact, FileMaster, FileMotion, FileOrthotropy};
 use super::{FileSetRef, ScenarioError};
-use adhesim::contact::detect::{thickness_twins, tributary_areas};
+use adhesim::contact::detect::{flat_quads, local_faces, thickness_twins, tributary_areas};
 use adhesim::contact::law::Orthotropy;
 use adhesim::contact::rcc::DEFAULT_BETA_EPS;
 use adhesim::contact::{
     ContactPair, InterfaceLaw, Master, PairDiscretisation, RccParams, RigidMotion, RigidShape,
 };
 use adhesim::mesh::Face;
-use std::collections::BTreeMap;
 
 /// The `[[contact]]` pairs in file order, with distinct names.
 pub(super) fn build_contacts(
@@ -52,6 +51,17 @@ fn build_contact(
     let slave = Slave::build(&c.slave, key, bodies, ctx)?;
     let discretisation = build_discretisation(c, key, ctx)?;
     let master = build_master(c, key, slave.body, discretisation, bodies, ctx)?;
+    let quadratic_master = matches!(&master, Master::Faces(f) if f.iter().any(Face::is_quadratic));
+    let deformable_master = matches!(&master, Master::Faces(_));
+    if discretisation != PairDiscretisation::Mortar
+        && deformable_master
+        && (slave.quadratic || quadratic_master)
+    {
+        let side = if slave.quadratic { "slave" } else { "master" };
+        return Err(ctx.err(format!(
+            "`{key}.{side}.set` holds second-order faces (tri6, of tet10 elements); between two bodies node-to-surface contact does not pass the contact patch test with them: set `{key}.discretisation = \"mortar\"`"
+        )));
+    }
     let mu = c.friction;
     if !(mu.is_finite() && mu >= 0.0) {
         return Err(ctx.err(format!(
@@ -78,7 +88,8 @@ fn build_contact(
         master,
         law: InterfaceLaw::rcc(mu, adhesion, anisotropy),
         detection_distance,
-        slave_quads: slave.quads,
+        slave_quads: flat_quads(&slave.faces),
+        slave_faces: slave.faces,
         thickness_twins,
         discretisation,
     })
@@ -117,9 +128,11 @@ struct Slave {
     nodes: Vec<usize>,
     /// Tributary area [m²] of each slave node.
     area: Vec<f64>,
-    /// The slave faces as quadrangles of indices into the slave nodes (a triangle repeats
-    /// its last node); faces with a node outside the slave nodes are left out.
-    quads: Vec<[usize; 4]>,
+    /// The slave faces with indices into the slave nodes; faces with a node outside the
+    /// slave nodes are left out.
+    faces: Vec<Face>,
+    /// Whether the face set holds second-order faces.
+    quadratic: bool,
     /// Mean edge length [m] of the slave faces.
     mean_edge: f64,
 }
@@ -140,7 +153,8 @@ impl Slave {
             }
         };
         let area = tributary_areas(&faces, &mesh.nodes, &local_nodes);
-        let quads = slave_quads(&faces, &local_nodes);
+        let quadratic = faces.iter().any(Face::is_quadratic);
+        let faces_local = local_faces(&faces, &local_nodes);
         let nodes = local_nodes.iter().map(|n| n + bodies.offsets[sb]).collect();
         let mean_edge = mean_edge(&faces, &mesh.nodes);
         Ok(Slave {
@@ -148,7 +162,8 @@ impl Slave {
             local_nodes,
             nodes,
             area,
-            quads,
+            faces: faces_local,
+            quadratic,
             mean_edge,
         })
     }
@@ -168,34 +183,12 @@ impl Slave {
     }
 }
 
-/// The faces as quadrangles of indices into `local_nodes` (see [`Slave::quads`]).
-fn slave_quads(faces: &[Face], local_nodes: &[usize]) -> Vec<[usize; 4]> {
-    let index: BTreeMap<usize, usize> = local_nodes
-        .iter()
-        .enumerate()
-        .map(|(i, &n)| (n, i))
-        .collect();
-    faces
-        .iter()
-        .filter_map(|f| {
-            let q = match f {
-                Face::Quad(n) => *n,
-                Face::Tri(n) => [n[0], n[1], n[2], n[2]],
-            };
-            let m = q.map(|n| index.get(&n).copied());
-            m.iter()
-                .all(Option::is_some)
-                .then(|| m.map(|i| i.unwrap_or(0)))
-        })
-        .collect()
-}
-
 /// Mean length [m] of the faces' edges (0 without faces).
 fn mean_edge(faces: &[Face], nodes: &[[f64; 3]]) -> f64 {
     let mut sum = 0.0;
     let mut count = 0;
     for f in faces {
-        let ns = f.nodes();
+        let ns = f.corners();
         for i in 0..ns.len() {
             let (a, b) = (nodes[ns[i]], nodes[ns[(i + 1) % ns.len()]]);
             sum += ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
@@ -277,6 +270,7 @@ fn deformable_master(
             .map(|f| match f {
                 Face::Quad(n) => Face::Quad(n.map(|i| i + off)),
                 Face::Tri(n) => Face::Tri(n.map(|i| i + off)),
+                Face::Tri6(n) => Face::Tri6(n.map(|i| i + off)),
             })
             .collect(),
     ))

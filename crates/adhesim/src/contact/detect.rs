@@ -110,9 +110,13 @@ pub struct ContactPair {
     /// Slave nodes farther than this from the master at the start of a step are not
     /// candidates (and lose their bond) [m].
     pub detection_distance: f64,
-    /// Faces of the slave surface as indices into `slave_nodes` (a triangle repeats its
-    /// last node), for maps of contact fields over the surface.
+    /// The flat pieces of the slave faces ([`Face::flat_pieces`]) as indices into
+    /// `slave_nodes` (a triangle repeats its last node), for maps of contact fields over the
+    /// surface and the slave normals: [`flat_quads`] of `slave_faces`.
     pub slave_quads: Vec<[usize; 4]>,
+    /// The slave faces with indices into `slave_nodes`, as the mesh holds them (mortar
+    /// integrates over them).
+    pub slave_faces: Vec<Face>,
     /// Plane strain: for each slave node, the other slave nodes on its line through the
     /// slab's thickness (same x and y), as indices into `slave_nodes`; empty lists for a 3D
     /// pair. Such a line is one contact point of the plane problem (see [`ContactPoint`]).
@@ -144,17 +148,50 @@ pub fn thickness_twins(nodes: &[usize], coords: &[[f64; 3]]) -> Vec<Vec<usize>> 
         .collect()
 }
 
-/// Tributary areas of the nodes of a face set: each face's area split equally among its
-/// nodes [m²], in the order of `nodes`.
+/// The faces of `faces` whose nodes are all in `nodes`, with their nodes as indices into
+/// `nodes` (the form of [`ContactPair::slave_faces`]).
+pub fn local_faces(faces: &[Face], nodes: &[usize]) -> Vec<Face> {
+    let index: HashMap<usize, usize> = nodes.iter().enumerate().map(|(i, &n)| (n, i)).collect();
+    faces
+        .iter()
+        .filter_map(|f| {
+            let m: Option<Vec<usize>> = f.nodes().iter().map(|n| index.get(n).copied()).collect();
+            m.map(|m| Face::of_cell(&m, &(0..m.len()).collect::<Vec<_>>()))
+        })
+        .collect()
+}
+
+/// The flat pieces of `faces` ([`Face::flat_pieces`]) as quadrangles of the faces' node
+/// indices, a triangle repeating its last node.
+pub fn flat_quads(faces: &[Face]) -> Vec<[usize; 4]> {
+    let mut out = Vec::new();
+    for f in faces {
+        let ns = f.nodes();
+        for piece in f.flat_pieces() {
+            let at = |i: usize| ns[piece[i.min(piece.len() - 1)]];
+            out.push([at(0), at(1), at(2), at(3)]);
+        }
+    }
+    out
+}
+
+/// Tributary areas of the nodes of a face set: the area of each flat piece of each face
+/// ([`Face::flat_pieces`], the face itself when it is linear) split equally among the
+/// piece's corners [m²], in the order of `nodes`. On a six-node triangle that gives a corner
+/// 1/12 of the face and a mid-side node 1/4 (the integrals of the sub-triangles' hat
+/// functions): positive, where the quadratic corner functions integrate to zero.
 pub fn tributary_areas(faces: &[Face], coords: &[[f64; 3]], nodes: &[usize]) -> Vec<f64> {
     let index: HashMap<usize, usize> = nodes.iter().enumerate().map(|(i, &n)| (n, i)).collect();
     let mut area = vec![0.0; nodes.len()];
     for f in faces {
-        let ns = f.nodes();
-        let a = face_area(ns, coords);
-        for n in ns {
-            if let Some(&i) = index.get(n) {
-                area[i] += a / ns.len() as f64;
+        let all = f.nodes();
+        for piece in f.flat_pieces() {
+            let ns: Vec<usize> = piece.iter().map(|&c| all[c]).collect();
+            let a = face_area(&ns, coords);
+            for n in &ns {
+                if let Some(&i) = index.get(n) {
+                    area[i] += a / ns.len() as f64;
+                }
             }
         }
     }
@@ -439,7 +476,46 @@ pub fn project_on_face(
             let xm = std::array::from_fn(|k| w[0] * p[0][k] + w[1] * p[1][k] + w[2] * p[2][k]);
             (xm, n, w)
         }
+        Face::Tri6(ns) => project_on_tri6(&ns.map(|n| Vec3::from(pos(n))), Vec3::from(x)),
     }
+}
+
+/// Closest-point projection of `x` on a six-node triangle with nodes `p` by Gauss-Newton in
+/// its natural coordinates (ξ, η), kept in the triangle; returns the point, the unit normal
+/// there and the nodal weights.
+fn project_on_tri6(p: &[Vec3; 6], x: Vec3) -> ([f64; 3], [f64; 3], Vec<f64>) {
+    let eval = |a: f64, b: f64| {
+        let (w, dw) = crate::element::tri6_shape(a, b);
+        let comb = |c: &dyn Fn(usize) -> f64| -> Vec3 { (0..6).map(|i| c(i) * p[i]).sum() };
+        (w, comb(&|i| w[i]), comb(&|i| dw[i][0]), comb(&|i| dw[i][1]))
+    };
+    let (mut a, mut b) = (1.0 / 3.0, 1.0 / 3.0);
+    for _ in 0..20 {
+        let (_, xm, ta, tb) = eval(a, b);
+        let r = x - xm;
+        let (g1, g2) = (r.dot(&ta), r.dot(&tb));
+        let (m11, m12, m22) = (ta.dot(&ta), ta.dot(&tb), tb.dot(&tb));
+        let det = m11 * m22 - m12 * m12;
+        if !(det > 0.0) {
+            break;
+        }
+        let da = (m22 * g1 - m12 * g2) / det;
+        let db = (m11 * g2 - m12 * g1) / det;
+        let (a0, b0) = (a, b);
+        a = (a + da).max(0.0);
+        b = (b + db).max(0.0);
+        if a + b > 1.0 {
+            let s = a + b;
+            a /= s;
+            b /= s;
+        }
+        if (a - a0).abs() + (b - b0).abs() < 1e-12 {
+            break;
+        }
+    }
+    let (w, xm, ta, tb) = eval(a, b);
+    let n = unit(ta.cross(&tb));
+    (xm.into(), n.into(), w.to_vec())
 }
 
 /// A uniform grid over the master faces' bounding boxes (inflated by the detection

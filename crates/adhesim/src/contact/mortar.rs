@@ -30,6 +30,7 @@
 use super::detect::Master;
 use super::detect::{frame_from_normal, unit, ContactPair, ContactPoint, Discretisation, FaceGrid};
 use super::polygon::{clip, counter_clockwise, polygon_quadrature, shape_at, Point2};
+use crate::element::{tri6_shape, TRI6_NODE_XI};
 use crate::mesh::Face;
 use crate::Vec3;
 use std::collections::{BTreeMap, HashSet};
@@ -57,16 +58,18 @@ impl Discretisation for Mortar {
         let grid = FaceGrid::new(faces, &pos, pair.detection_distance);
         let sides = Sides::new(pair, faces);
         let mut integrals = vec![NodeIntegrals::default(); pair.slave_nodes.len()];
-        for quad in &pair.slave_quads {
-            let face = SlaveFace::new(pair, quad, &pos, &|n| reference[n]);
-            face.integrate(
-                faces,
-                &grid,
-                &sides,
-                &pos,
-                pair.detection_distance,
-                &mut integrals,
-            );
+        for face in &pair.slave_faces {
+            for &piece in face.flat_pieces() {
+                let slave = SlavePiece::new(pair, face, piece, &pos, &|n| reference[n]);
+                slave.integrate(
+                    faces,
+                    &grid,
+                    &sides,
+                    &pos,
+                    pair.detection_distance,
+                    &mut integrals,
+                );
+            }
         }
         let normals = slave_normals(pair, &pos);
         let node_site =
@@ -108,9 +111,9 @@ struct Sides {
 impl Sides {
     fn new(pair: &ContactPair, master: &[Face]) -> Self {
         let slave = pair
-            .slave_quads
+            .slave_faces
             .iter()
-            .map(|q| key(q.iter().map(|&l| pair.slave_nodes[l])))
+            .map(|f| key(f.nodes().iter().map(|&l| pair.slave_nodes[l])))
             .collect();
         let master = master
             .iter()
@@ -200,39 +203,76 @@ impl NodeIntegrals {
     }
 }
 
-/// A slave face laid on its plane.
-struct SlaveFace {
-    /// Indices of its nodes in the pair (three or four).
+/// How a point of a flat piece of a face gives the face's shape functions.
+#[derive(Clone, Copy, Debug)]
+enum PieceShape {
+    /// The piece is the whole (linear) face: its own weights are the shape functions.
+    Linear,
+    /// A sub-triangle of a six-node triangle: the natural coordinates of its corners.
+    Tri6([[f64; 2]; 3]),
+}
+
+impl PieceShape {
+    /// The shape of `piece` (positions in the node list of `face`).
+    fn of(face: &Face, piece: &[usize]) -> Self {
+        match face {
+            Face::Tri6(_) => PieceShape::Tri6(std::array::from_fn(|c| TRI6_NODE_XI[piece[c]])),
+            Face::Quad(_) | Face::Tri(_) => PieceShape::Linear,
+        }
+    }
+
+    /// The face's shape functions (one per node of the face) at the point of the piece where
+    /// the piece's own linear or bilinear weights are `w`.
+    fn face_shape(&self, w: Vec<f64>) -> Vec<f64> {
+        match self {
+            PieceShape::Linear => w,
+            PieceShape::Tri6(xi) => {
+                let at = |k: usize| w[0] * xi[0][k] + w[1] * xi[1][k] + w[2] * xi[2][k];
+                tri6_shape(at(0), at(1)).0.to_vec()
+            }
+        }
+    }
+}
+
+/// A flat piece of a slave face ([`Face::flat_pieces`]: the face itself when it is linear)
+/// laid on its plane. The contact pressure is interpolated on it linearly (bilinearly on a
+/// quadrilateral) from the piece's corners, each corner standing for its node: with linear
+/// faces that is the face's own shape functions (standard mortar); on a six-node triangle,
+/// the hat functions of its four sub-triangles, which are positive with positive integrals
+/// where the quadratic corner functions integrate to zero.
+struct SlavePiece {
+    /// Indices in the pair of the face's nodes.
     locals: Vec<usize>,
-    /// Global indices of its nodes.
+    /// Global indices of the face's nodes.
     nodes: Vec<usize>,
+    /// The piece's corners, as positions in `nodes`.
+    piece: &'static [usize],
+    /// How the piece's weights give the face's shape functions.
+    shape: PieceShape,
     /// Centre [m] and unit outward normal of its plane, with two in-plane axes.
     centre: Vec3,
     normal: Vec3,
     axes: [Vec3; 2],
-    /// Its corners on the plane, in node order.
+    /// Its corners on the plane, in the piece's order.
     corners: Vec<Point2>,
     /// Reference area over current area.
     area_ratio: f64,
 }
 
-impl SlaveFace {
-    /// The slave face `quad` (indices into the pair's slave nodes; a triangle repeats its
-    /// last node) at the positions `pos`, with reference positions `reference`.
+impl SlavePiece {
+    /// The piece `piece` of the slave face `face` (indices into the pair's slave nodes) at
+    /// the positions `pos`, with reference positions `reference`.
     fn new(
         pair: &ContactPair,
-        quad: &[usize; 4],
+        face: &Face,
+        piece: &'static [usize],
         pos: &dyn Fn(usize) -> [f64; 3],
         reference: &dyn Fn(usize) -> [f64; 3],
     ) -> Self {
-        let locals: Vec<usize> = if quad[2] == quad[3] {
-            quad[..3].to_vec()
-        } else {
-            quad.to_vec()
-        };
+        let locals = face.nodes().to_vec();
         let nodes: Vec<usize> = locals.iter().map(|&l| pair.slave_nodes[l]).collect();
         let at = |f: &dyn Fn(usize) -> [f64; 3]| -> Vec<Vec3> {
-            nodes.iter().map(|&n| Vec3::from(f(n))).collect()
+            piece.iter().map(|&c| Vec3::from(f(nodes[c]))).collect()
         };
         let (x, x_ref) = (at(pos), at(reference));
         let (a, a_ref) = (twice_area_vector(&x), twice_area_vector(&x_ref));
@@ -244,9 +284,11 @@ impl SlaveFace {
             .iter()
             .map(|p| [(p - centre).dot(&axes[0]), (p - centre).dot(&axes[1])])
             .collect();
-        SlaveFace {
+        SlavePiece {
+            shape: PieceShape::of(face, piece),
             locals,
             nodes,
+            piece,
             centre,
             normal,
             axes,
@@ -255,13 +297,13 @@ impl SlaveFace {
         }
     }
 
-    /// A point of space on the face's plane.
+    /// A point of space on the piece's plane.
     fn project(&self, x: [f64; 3]) -> Point2 {
         let d = Vec3::from(x) - self.centre;
         [d.dot(&self.axes[0]), d.dot(&self.axes[1])]
     }
 
-    /// Adds this face's segments with the master `faces` near it to the slave nodes'
+    /// Adds this piece's segments with the master `faces` near it to the slave nodes'
     /// integrals.
     fn integrate(
         &self,
@@ -275,59 +317,65 @@ impl SlaveFace {
         let own = key(self.nodes.iter().copied());
         let slave_polygon = counter_clockwise(self.corners.clone());
         for (p, w) in polygon_quadrature(&slave_polygon) {
-            let n = shape_at(&self.corners, p);
-            for (i, &l) in self.locals.iter().enumerate() {
-                integrals[l].full += w * n[i];
+            let phi = shape_at(&self.corners, p);
+            for (c, &at) in self.piece.iter().enumerate() {
+                integrals[self.locals[at]].full += w * phi[c];
             }
         }
         let (lo, hi) = self.bounding_box(pos);
         for fi in grid.candidates_in_box(lo, hi) {
-            let Some(master) = self.facing(&faces[fi], pos, detection) else {
-                continue;
-            };
             let master_nodes = faces[fi].nodes();
             if !sides.integrates(&own, &key(master_nodes.iter().copied())) {
                 continue;
             }
-            let segment = clip(&slave_polygon, &counter_clockwise(master.clone()));
-            if segment.is_empty() {
-                continue;
-            }
-            for (p, w) in polygon_quadrature(&segment) {
-                let ns = shape_at(&self.corners, p);
-                let nm = shape_at(&master, p);
-                for (i, &l) in self.locals.iter().enumerate() {
-                    let node = &mut integrals[l];
-                    node.covered += w * ns[i];
-                    node.nominal += w * ns[i] * self.area_ratio;
-                    for (k, &m) in master_nodes.iter().enumerate() {
-                        *node.master.entry(m).or_insert(0.0) += w * ns[i] * nm[k];
-                    }
-                    for (k, &n) in self.nodes.iter().enumerate() {
-                        *node.slave.entry(n).or_insert(0.0) += w * ns[i] * ns[k];
+            for piece in faces[fi].flat_pieces() {
+                let Some(master) = self.facing(&faces[fi], piece, pos, detection) else {
+                    continue;
+                };
+                let master_shape = PieceShape::of(&faces[fi], piece);
+                let segment = clip(&slave_polygon, &counter_clockwise(master.clone()));
+                if segment.is_empty() {
+                    continue;
+                }
+                for (p, w) in polygon_quadrature(&segment) {
+                    let phi = shape_at(&self.corners, p);
+                    let ns = self.shape.face_shape(phi.clone());
+                    let nm = master_shape.face_shape(shape_at(&master, p));
+                    for (c, &at) in self.piece.iter().enumerate() {
+                        let node = &mut integrals[self.locals[at]];
+                        node.covered += w * phi[c];
+                        node.nominal += w * phi[c] * self.area_ratio;
+                        for (k, &m) in master_nodes.iter().enumerate() {
+                            *node.master.entry(m).or_insert(0.0) += w * phi[c] * nm[k];
+                        }
+                        for (k, &n) in self.nodes.iter().enumerate() {
+                            *node.slave.entry(n).or_insert(0.0) += w * phi[c] * ns[k];
+                        }
                     }
                 }
             }
         }
     }
 
-    /// The corners of master face `face` on this face's plane, if it faces this face (its
-    /// normal against this one's) within `detection` [m] of its plane. A face sharing a node
-    /// with this one (its neighbour on a self-contact surface) must face it across a fold
-    /// sharper than 120°.
+    /// The corners of the piece `piece` of master face `face` on this piece's plane, if it
+    /// faces this piece (its normal against this one's) within `detection` [m] of its plane.
+    /// A face sharing a node with this one (its neighbour on a self-contact surface) must
+    /// face it across a fold sharper than 120°.
     fn facing(
         &self,
         face: &Face,
+        piece: &[usize],
         pos: &dyn Fn(usize) -> [f64; 3],
         detection: f64,
     ) -> Option<Vec<Point2>> {
-        let ns = face.nodes();
+        let all = face.nodes();
+        let ns: Vec<usize> = piece.iter().map(|&c| all[c]).collect();
         let x: Vec<Vec3> = ns.iter().map(|&n| Vec3::from(pos(n))).collect();
         let a = twice_area_vector(&x);
         let facing = a.dot(&self.normal) / a.norm();
         // A neighbour on the surface (a shared node) faces this face only across a fold
         // sharper than 120°, as the two lips of a slit do at its tip.
-        let neighbour = ns.iter().any(|n| self.nodes.contains(n));
+        let neighbour = all.iter().any(|n| self.nodes.contains(n));
         if !(facing < if neighbour { -0.5 } else { 0.0 }) {
             return None;
         }
@@ -343,12 +391,12 @@ impl SlaveFace {
         Some(ns.iter().map(|&n| self.project(pos(n))).collect())
     }
 
-    /// The bounding box of the face's nodes [m].
+    /// The bounding box of the piece's corners [m].
     fn bounding_box(&self, pos: &dyn Fn(usize) -> [f64; 3]) -> ([f64; 3], [f64; 3]) {
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
-        for &n in &self.nodes {
-            let p = pos(n);
+        for &c in self.piece {
+            let p = pos(self.nodes[c]);
             for k in 0..3 {
                 lo[k] = lo[k].min(p[k]);
                 hi[k] = hi[k].max(p[k]);
@@ -475,6 +523,7 @@ mod tests {
             master: Master::Faces(master),
             law: InterfaceLaw::rcc(0.0, None, None),
             detection_distance: 0.1,
+            slave_faces: slave_quads.iter().map(|&q| Face::Quad(q)).collect(),
             slave_quads,
             thickness_twins: Vec::new(),
             discretisation: Default::default(),

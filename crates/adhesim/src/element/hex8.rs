@@ -39,6 +39,7 @@ pub static HEX8: ElementType = ElementType {
     },
     vtk_type: 12,
     gmsh_type: 5,
+    gmsh_nodes: &[0, 1, 2, 3, 4, 5, 6, 7],
 };
 
 /// The hex8 element at compile time.

@@ -11,17 +11,20 @@
 //!   and the assembly loops are compiled for each type (no dynamic dispatch per element or
 //!   Gauss point).
 //!
-//! The types are trilinear hex8 (2×2×2 Gauss, `hex8.rs`) and linear tet4 (1 point, `tet4.rs`).
+//! The types are trilinear hex8 (2×2×2 Gauss, `hex8.rs`), linear tet4 (1 point, `tet4.rs`)
+//! and quadratic tet10 (4 points, `tet10.rs`).
 //! Reference-configuration data (shape-function gradients, weights) are computed once; the
 //! kernels turn nodal displacements into internal force, consistent tangent (material +
 //! geometric) and strain energy.
 
 pub(crate) mod hex8;
+pub(crate) mod tet10;
 pub(crate) mod tet4;
 
 pub use hex8::{
     hex8_centre, hex8_gauss_points, hex8_geometry, hex8_shape, Hex8, HEX8, HEX_NODE_XI,
 };
+pub use tet10::{tet10_geometry, tet10_shape, tri6_shape, Tet10, TET10, TET10_EDGES, TRI6_NODE_XI};
 pub use tet4::{tet4_geometry, tet4_shape, Tet4, TET4};
 
 use crate::material::Hyperelastic;
@@ -51,6 +54,7 @@ macro_rules! element_types {
 element_types! {
     Hex8, 8, 8, HEX8;
     Tet4, 4, 1, TET4;
+    Tet10, 10, 4, TET10;
 }
 
 /// What is done with each element type's Rust type ([`visit_element_types`]).
@@ -75,8 +79,9 @@ pub struct ElementType {
     /// Shape functions N_a and natural derivatives ∂N_a/∂ξ at ξ, as [`Element::shape`]
     /// gives them.
     pub shape: fn(xi: [f64; 3]) -> ShapeValues,
-    /// Local node indices of each face (a quadrilateral or a triangle), counter-clockwise
-    /// seen from outside the cell: boundary extraction and face sets use them.
+    /// Local node indices of each face (a quadrilateral, a triangle, or a six-node triangle:
+    /// its corners, then its mid-side nodes), corners counter-clockwise seen from outside the
+    /// cell: boundary extraction and face sets use them.
     pub faces: &'static [&'static [usize]],
     /// Corners for the scaled-Jacobian quality measure ([`crate::mesh::quality`]): each the
     /// corner node and its three neighbours along the natural axes, ordered so that the edge
@@ -89,6 +94,8 @@ pub struct ElementType {
     pub vtk_type: u8,
     /// Gmsh element type number (MSH 4.1).
     pub gmsh_type: i32,
+    /// For each node of the cell, its position in Gmsh's node list of the element.
+    pub gmsh_nodes: &'static [usize],
 }
 
 /// The type's name: the `Debug` form of meshes (and so the checkpoint fingerprint of a
@@ -128,6 +135,11 @@ impl ElementType {
             .iter()
             .copied()
             .find(|t| t.gmsh_type == gmsh_type)
+    }
+
+    /// Whether the type is of second order (its faces have mid-side nodes).
+    pub fn is_quadratic(&self) -> bool {
+        self.faces.iter().any(|f| f.len() > 4)
     }
 
     /// The type called `name`, if adhesim has it.
@@ -539,6 +551,7 @@ mod table_tests {
             let x = t.natural_nodes;
             let mut volume = 0.0;
             for f in t.faces {
+                let f = crate::mesh::corners_of(f);
                 for k in 1..f.len() - 1 {
                     let (p, q, r) = (x[f[0]], x[f[k]], x[f[k + 1]]);
                     volume += Vec3::from(p).dot(&sub(q, p).cross(&sub(r, p))) / 6.0;
@@ -567,6 +580,7 @@ mod table_tests {
             let c = c.map(|v| v / t.nodes as f64);
             let mut edges = std::collections::HashMap::new();
             for f in t.faces {
+                let f = crate::mesh::corners_of(f);
                 let normal = sub(x[f[1]], x[f[0]]).cross(&sub(x[f[2]], x[f[0]]));
                 assert!(normal.dot(&sub(x[f[0]], c)) > 0.0, "{}: face {f:?}", t.name);
                 for k in 0..f.len() {

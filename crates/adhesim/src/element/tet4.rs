@@ -22,6 +22,7 @@ pub static TET4: ElementType = ElementType {
     inverted_inside: |_| false,
     vtk_type: 10,
     gmsh_type: 4,
+    gmsh_nodes: &[0, 1, 2, 3],
 };
 
 /// The tet4 element at compile time.

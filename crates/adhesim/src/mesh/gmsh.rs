@@ -154,6 +154,8 @@ pub struct MshFile {
     pub quads: Vec<Element<4>>,
     /// Tri3 elements.
     pub tris: Vec<Element<3>>,
+    /// Tri6 elements (faces of tet10 meshes).
+    pub tri6s: Vec<Element<6>>,
     /// Point (dimension 0) and line (dimension 1) elements: dimension, entity, nodes.
     pub low_dim: Vec<(i32, i32, Vec<usize>)>,
     /// Physical group names by (dimension, tag); unnamed groups are `physical_<tag>`.
@@ -291,6 +293,18 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<MshFile, GmshError> {
         return Err(p.err_here(format!(
             "the file holds no volume elements ({}): mesh the volumes in 3D (gmsh -3)",
             volume_type_names(" or ")
+        )));
+    }
+    let found: Vec<&str> = msh.volumes.iter().map(|v| v.element.name).collect();
+    let quadratic = msh
+        .volumes
+        .iter()
+        .filter(|v| v.element.is_quadratic())
+        .count();
+    if quadratic > 0 && quadratic < msh.volumes.len() {
+        return Err(p.err_here(format!(
+            "the file mixes first- and second-order volume elements ({}): their faces cannot match; mesh the whole body at one order (Mesh.ElementOrder)",
+            found.join(" and ")
         )));
     }
     // Name every physical group used by an entity.
@@ -809,7 +823,7 @@ impl Parser<'_> {
                     })
                     .collect();
                 return Err(self.err_at(at_type,
-                    format!("element type {etype} is not known: adhesim reads {} volumes, quad4 (3) and tri3 (2) faces", volumes.join(" and ")),
+                    format!("element type {etype} is not known: adhesim reads {} volumes, quad4 (3), tri3 (2) and tri6 (9) faces", volumes.join(", ")),
                 ));
             };
             if edim != dim {
@@ -818,15 +832,20 @@ impl Parser<'_> {
                 ));
             }
             let volume = ElementType::from_gmsh(etype);
-            let supported = matches!(etype, 2 | 3) || volume.is_some() || dim <= 1;
+            let supported = matches!(etype, 2 | 3 | 9) || volume.is_some() || dim <= 1;
             if !supported {
-                let fix = if matches!(etype, 6 | 7) {
+                let fix = if matches!(etype, 6 | 7 | 13 | 14 | 18 | 19) {
                     format!(
                         "adhesim meshes hold {} volumes only: remesh with hexahedra or tetrahedra",
                         volume_type_names(" and ")
                     )
+                } else if dim == 3 {
+                    format!(
+                        "the volume elements adhesim reads are {}: remesh with first-order elements (Mesh.ElementOrder = 1), or with second-order tetrahedra (Mesh.ElementOrder = 2 on a tetrahedral mesh)",
+                        volume_type_names(", ")
+                    )
                 } else {
-                    "remesh with first-order elements (Mesh.ElementOrder = 1)".to_string()
+                    "adhesim reads quad4, tri3 and tri6 surface elements: remesh with first-order elements (Mesh.ElementOrder = 1), or second-order tetrahedra, whose faces are tri6".to_string()
                 };
                 return Err(self.err_at(
                     at_type,
@@ -858,7 +877,9 @@ impl Parser<'_> {
                     let block = msh.volume_block_mut(element);
                     block.tags.push(tag);
                     block.entities.push(entity);
-                    block.nodes.extend_from_slice(&nodes);
+                    block
+                        .nodes
+                        .extend(element.gmsh_nodes.iter().map(|&g| nodes[g]));
                     continue;
                 }
                 match etype {
@@ -871,6 +892,11 @@ impl Parser<'_> {
                         tag,
                         entity,
                         nodes: [nodes[0], nodes[1], nodes[2], nodes[3]],
+                    }),
+                    9 => msh.tri6s.push(Element {
+                        tag,
+                        entity,
+                        nodes: std::array::from_fn(|k| nodes[k]),
                     }),
                     _ => {
                         // Points and lines: only their end nodes matter (node sets).
@@ -1076,7 +1102,8 @@ impl MshFile {
             .quads
             .iter()
             .map(|e| (e.tag, e.entity, &e.nodes[..]))
-            .chain(self.tris.iter().map(|e| (e.tag, e.entity, &e.nodes[..])));
+            .chain(self.tris.iter().map(|e| (e.tag, e.entity, &e.nodes[..])))
+            .chain(self.tri6s.iter().map(|e| (e.tag, e.entity, &e.nodes[..])));
         for (tag, entity, nodes) in surface {
             if self.groups(2, entity).next().is_none()
                 || nodes.iter().any(|&i| new_id[i] == usize::MAX)

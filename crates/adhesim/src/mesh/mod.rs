@@ -15,28 +15,39 @@
 
 use std::collections::BTreeMap;
 
-use crate::element::{ElementType, HEX8, TET4};
+use crate::element::{ElementType, HEX8, TET10, TET4};
 
 pub mod generate;
 pub mod gmsh;
 pub mod quality;
 
-/// A boundary face of a cell: a bilinear quadrilateral or a linear triangle.
+/// A boundary face of a cell: a bilinear quadrilateral, a linear triangle or a quadratic
+/// triangle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Face {
     /// Quadrilateral face of a hex8, nodes counter-clockwise seen from outside.
     Quad([usize; 4]),
     /// Triangular face of a tet4, nodes counter-clockwise seen from outside.
     Tri([usize; 3]),
+    /// Six-node triangular face of a tet10: corners counter-clockwise seen from outside, then
+    /// the mid-side nodes of edges 0-1, 1-2 and 2-0.
+    Tri6([usize; 6]),
 }
 
 impl Face {
-    /// The face of `cell` (global node indices) with local nodes `local` (three or four).
+    /// The face of `cell` (global node indices) with local nodes `local` (three, four or
+    /// six).
     pub fn of_cell(cell: &[usize], local: &[usize]) -> Face {
         match *local {
             [a, b, c] => Face::Tri([cell[a], cell[b], cell[c]]),
             [a, b, c, d] => Face::Quad([cell[a], cell[b], cell[c], cell[d]]),
-            _ => panic!("a cell face has three or four nodes, not {}", local.len()),
+            [a, b, c, d, e, f] => {
+                Face::Tri6([cell[a], cell[b], cell[c], cell[d], cell[e], cell[f]])
+            }
+            _ => panic!(
+                "a cell face has three, four or six nodes, not {}",
+                local.len()
+            ),
         }
     }
 
@@ -45,7 +56,42 @@ impl Face {
         match self {
             Face::Quad(n) => n,
             Face::Tri(n) => n,
+            Face::Tri6(n) => n,
         }
+    }
+
+    /// The face's corner nodes, counter-clockwise seen from outside.
+    pub fn corners(&self) -> &[usize] {
+        corners_of(self.nodes())
+    }
+
+    /// The flat pieces the face is drawn and integrated on: itself when it is linear; a
+    /// six-node triangle's four sub-triangles (corner, mid, mid and the middle one), each
+    /// counter-clockwise. Entries are positions in [`Face::nodes`].
+    pub fn flat_pieces(&self) -> &'static [&'static [usize]] {
+        match self {
+            Face::Quad(_) => &[&[0, 1, 2, 3]],
+            Face::Tri(_) => &[&[0, 1, 2]],
+            Face::Tri6(_) => TRI6_PIECES,
+        }
+    }
+
+    /// Whether the face is of second order (has mid-side nodes).
+    pub fn is_quadratic(&self) -> bool {
+        matches!(self, Face::Tri6(_))
+    }
+}
+
+/// The four sub-triangles of a six-node triangle, as positions in its node list.
+pub const TRI6_PIECES: &[&[usize]] = &[&[0, 3, 5], &[3, 1, 4], &[5, 4, 2], &[3, 4, 5]];
+
+/// The corners of a face given by its nodes (three, four or six): the first three of a
+/// six-node triangle, all the nodes of a linear face.
+pub fn corners_of(nodes: &[usize]) -> &[usize] {
+    match nodes.len() {
+        6 => &nodes[..3],
+        8 | 9 => &nodes[..4],
+        _ => nodes,
     }
 }
 
@@ -275,6 +321,66 @@ impl Mesh {
     }
 }
 
+impl Mesh {
+    /// The same tetrahedral body with second-order tetrahedra: a node at the middle of every
+    /// edge (shared by the cells around it), each tet4 becoming a straight-sided tet10; face
+    /// sets become six-node triangles and node sets take the mid-side nodes of edges whose
+    /// ends are both in the set. Hexahedra are split first ([`Mesh::split_hexes_into_tets`]).
+    pub fn with_mid_side_nodes(&self) -> Mesh {
+        let tets = if self.hexes().is_empty() {
+            self.clone()
+        } else {
+            self.split_hexes_into_tets()
+        };
+        let mut out = Mesh {
+            nodes: tets.nodes.clone(),
+            ..Default::default()
+        };
+        let mut mid: std::collections::HashMap<(usize, usize), usize> =
+            std::collections::HashMap::new();
+        let mut mid_of = |a: usize, b: usize, nodes: &mut Vec<[f64; 3]>| -> usize {
+            let k = (a.min(b), a.max(b));
+            *mid.entry(k).or_insert_with(|| {
+                let (p, q) = (nodes[a], nodes[b]);
+                nodes.push(std::array::from_fn(|i| 0.5 * (p[i] + q[i])));
+                nodes.len() - 1
+            })
+        };
+        let mut cells = Vec::with_capacity(tets.tets().len());
+        for t in tets.tets() {
+            let mut c = [0usize; 10];
+            c[..4].copy_from_slice(t);
+            for (m, [i, j]) in crate::element::tet10::TET10_EDGES.iter().enumerate() {
+                c[4 + m] = mid_of(t[*i], t[*j], &mut out.nodes);
+            }
+            cells.push(c);
+        }
+        out.add_cells(&TET10, cells);
+        for (name, ids) in &tets.node_sets {
+            let inside: std::collections::HashSet<usize> = ids.iter().copied().collect();
+            let mut with_mids = ids.clone();
+            with_mids.extend(
+                mid.iter()
+                    .filter(|((a, b), _)| inside.contains(a) && inside.contains(b))
+                    .map(|(_, &m)| m),
+            );
+            out.set_nodes(name, with_mids);
+        }
+        for (name, faces) in &tets.face_sets {
+            let quadratic = faces
+                .iter()
+                .map(|f| {
+                    let n = f.nodes();
+                    let m = |a: usize, b: usize| mid[&(n[a].min(n[b]), n[a].max(n[b]))];
+                    Face::Tri6([n[0], n[1], n[2], m(0, 1), m(1, 2), m(2, 0)])
+                })
+                .collect();
+            out.face_sets.insert(name.clone(), quadratic);
+        }
+        out
+    }
+}
+
 /// Hex8 node (VTK order) at each corner of the unit cube, indexed by x + 2y + 4z.
 const HEX_CORNER: [usize; 8] = [0, 1, 3, 2, 4, 5, 7, 6];
 
@@ -328,7 +434,7 @@ impl Mesh {
             let mut tris = Vec::new();
             for f in faces {
                 match f {
-                    Face::Tri(_) => tris.push(*f),
+                    Face::Tri(_) | Face::Tri6(_) => tris.push(*f),
                     Face::Quad(q) => {
                         for skip in 0..4 {
                             let mut key: Vec<usize> =

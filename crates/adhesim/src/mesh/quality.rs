@@ -127,8 +127,9 @@ fn check_face(
             outward.nodes()
         ));
     }
-    let normal = newell_normal(&mesh.nodes, nodes);
-    let away = centroid(&mesh.nodes, nodes) - cell_centroid(mesh, cell);
+    let corners = super::corners_of(nodes);
+    let normal = newell_normal(&mesh.nodes, corners);
+    let away = centroid(&mesh.nodes, corners) - cell_centroid(mesh, cell);
     if normal.dot(&away) <= 0.0 {
         let normal = [normal[0], normal[1], normal[2]];
         return Err(format!(
@@ -138,10 +139,18 @@ fn check_face(
     Ok(())
 }
 
-/// True if `b` lists the same cyclic sequence as `a` (same orientation).
+/// True if `b` lists the same face as `a` with the same orientation: the same cyclic
+/// sequence of corners, and for a six-node triangle the mid-side nodes turned with them.
 fn same_cycle(a: &[usize], b: &[usize]) -> bool {
-    let n = a.len();
-    n == b.len() && (0..n).any(|shift| (0..n).all(|k| a[k] == b[(k + shift) % n]))
+    if a.len() != b.len() {
+        return false;
+    }
+    let n = super::corners_of(a).len();
+    let mids = a.len() - n;
+    (0..n).any(|shift| {
+        (0..n).all(|k| a[k] == b[(k + shift) % n])
+            && (0..mids).all(|k| a[n + k] == b[n + (k + shift) % n])
+    })
 }
 
 /// Newell's area-weighted normal of a polygon (right-hand rule over the node order).
