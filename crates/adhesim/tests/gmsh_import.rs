@@ -299,7 +299,7 @@ fn malformed_files_give_errors_with_file_and_line() {
     let e = read_bad("hex20.msh", bad.as_bytes());
     assert_eq!(e.location, Some(Location::Line(at)), "{e}");
     assert!(
-        e.message.contains("hex20 (Gmsh type 17) is not supported: remesh with first-order elements (Mesh.ElementOrder = 1)"),
+        e.message.contains("hex20 (Gmsh type 17) is not supported: the volume elements adhesim reads are hex8, tet4, tet10: remesh with first-order elements (Mesh.ElementOrder = 1)"),
         "{e}"
     );
 
