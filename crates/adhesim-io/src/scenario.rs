@@ -114,7 +114,7 @@ impl<'de> Deserialize<'de> for FileMesh {
                 "give either `generator` (a built-in mesh) or `file` (a Gmsh .msh file), not both",
             )),
             (false, false) => Err(D::Error::custom(
-                "a mesh needs `generator` (\"block\", \"disk\", \"half_disk\", \"quarter_hemisphere\") or `file` (a Gmsh MSH 4.1 file)",
+                "a mesh needs `generator` (\"block\", \"disk\", \"half_disk\", \"quarter_hemisphere\", \"tube\") or `file` (a Gmsh MSH 4.1 file)",
             )),
         }
     }
@@ -151,6 +151,14 @@ enum FileGenerator {
     QuarterHemisphere {
         radius: f64,
         n: usize,
+    },
+    Tube {
+        inner: [f64; 2],
+        outer: [f64; 2],
+        thickness: f64,
+        n_around: usize,
+        n_radial: usize,
+        grip: Option<f64>,
     },
 }
 

@@ -27,11 +27,12 @@ const HEIGHT: f64 = 1.0;
 const YOUNG: f64 = 1e6;
 const TOP_AREA: f64 = 2.0;
 
-/// The slit block, with node sets from coordinates and the face sets `lower_lip` (facing +y)
-/// and `upper_lip` (facing −y).
-fn slit_block() -> Mesh {
+/// The block slit from x = 0 to `tip_x` [m] (cut through when `tip_x` is beyond its length,
+/// 2 m, its two parts still one body), with node sets from coordinates and the face sets
+/// `lower_lip` (facing +y) and `upper_lip` (facing −y).
+fn slit_block(tip_x: f64) -> Mesh {
     let mut mesh = generate::block([2.0, HEIGHT, 1.0], [8, 4, 2]);
-    let on_slit = |x: [f64; 3]| (x[1] - SLIT_Y).abs() < 1e-9 && x[0] < TIP_X - 1e-9;
+    let on_slit = |x: [f64; 3]| (x[1] - SLIT_Y).abs() < 1e-9 && x[0] < tip_x - 1e-9;
     let mut twin: HashMap<usize, usize> = HashMap::new();
     for n in 0..mesh.nodes.len() {
         if on_slit(mesh.nodes[n]) {
@@ -133,17 +134,21 @@ struct Slit {
     sites: usize,
 }
 
-/// The slit block with the top moved by `top` [m] over time, in steps `dt` [s], the lips a
-/// self-contact pair `slave` on `master` with the law `law`.
+/// The block slit to `tip_x` [m] with the top moved by `top` [m] over time, in steps `dt`
+/// [s], the lips a self-contact pair `slave` on `master` with the law `law`; `on_step` sees
+/// the stepper and the top's reaction [N] after each step.
+#[allow(clippy::too_many_arguments)]
 fn run_slit(
+    tip_x: f64,
     slave: &[&str],
     master: &[&str],
     solver: ContactSolver,
     law: InterfaceLaw,
     top: Table,
     dt: f64,
+    on_step: &mut dyn FnMut(&Stepper, f64),
 ) -> Slit {
-    let mesh = slit_block();
+    let mesh = slit_block(tip_x);
     let t_end = *top.t.last().unwrap();
     let problem = Problem {
         name: "slit".into(),
@@ -195,6 +200,8 @@ fn run_slit(
             Ok(r) => r.contact_points,
             Err(e) => panic!("{slave:?} on {master:?}, {solver:?}: {e:?}"),
         };
+        let f = s.disc.assemble(&s.state.u, false).force;
+        on_step(&s, -top_nodes.iter().map(|&n| f[3 * n + 1]).sum::<f64>());
     }
     let f = s.disc.assemble(&s.state.u, false).force;
     Slit {
@@ -210,7 +217,7 @@ fn compress(slave: &[&str], master: &[&str], solver: ContactSolver) -> (f64, usi
         v: vec![0.0, -PUSH],
     };
     let law = InterfaceLaw::rcc(0.0, None, None);
-    let r = run_slit(slave, master, solver, law, push, 1.0);
+    let r = run_slit(TIP_X, slave, master, solver, law, push, 1.0, &mut |_, _| {});
     (r.reaction, r.sites)
 }
 
@@ -236,5 +243,91 @@ fn a_slit_block_carries_the_uncut_stress_across_its_lips_in_self_contact() {
                 "{slave:?} on {master:?}, {solver:?}: {reaction} N"
             );
         }
+    }
+}
+
+/// Interface of the cut block: C_n = C_t [N/m³] (the cut block's stiffness E/H = 10⁶ N/m³
+/// exceeds the interface's steepest softening, 3 C_n, so that the pull is stable under
+/// displacement control), w [J/m²], and w/b [1/s], fast against the pull.
+const CUT_CN: f64 = 2e5;
+const CUT_W: f64 = 0.05;
+const CUT_W_OVER_B: f64 = 1e4;
+
+/// Peak tensile reaction [N] and work of the tensile reaction over the pull [J] of a block
+/// cut through on y = 0.5 (its two parts one body), its lips `slave` on `master`, pressed
+/// 1 µm, bonded, then pulled 20 openings u_c = √(w/C_n) apart in 2000 steps.
+fn cut_block_pull_off(slave: &[&str], master: &[&str], solver: ContactSolver) -> (f64, f64) {
+    use adhesim::contact::RccParams;
+    let bond = RccParams::new(CUT_W, CUT_CN, CUT_CN, CUT_W / CUT_W_OVER_B);
+    let law = InterfaceLaw::rcc(0.0, Some(bond), None);
+    let u_c = (CUT_W / CUT_CN).sqrt();
+    let top = Table {
+        t: vec![0.0, 0.1, 0.2, 1.2],
+        v: vec![0.0, -1e-6, -1e-6, 20.0 * u_c],
+    };
+    let (mut history, mut bonded_at_hold) = (Vec::new(), 0);
+    run_slit(
+        5.0,
+        slave,
+        master,
+        solver,
+        law,
+        top.clone(),
+        5e-4,
+        &mut |s, f| {
+            history.push((top.at(s.state.t), f));
+            if (s.state.t - 0.2).abs() < 1e-9 {
+                bonded_at_hold = s.contact[0].iter().filter(|c| c.history.bonded()).count();
+            }
+        },
+    );
+    assert!(
+        bonded_at_hold > 0,
+        "{slave:?} on {master:?}: no site bonded"
+    );
+    // Pulling up: the lips hold the upper part down, a negative reaction.
+    let tension = |f: f64| (-f).max(0.0);
+    let peak = history.iter().map(|r| tension(r.1)).fold(0.0, f64::max);
+    let work = history
+        .windows(2)
+        .filter(|p| p[1].0 > p[0].0)
+        .map(|p| 0.5 * (tension(p[0].1) + tension(p[1].1)) * (p[1].0 - p[0].0))
+        .sum();
+    (peak, work)
+}
+
+/// Adhesive self-contact against the closed form of the interface: a block cut through by a
+/// plane (its two parts one body, so the lips are in self-contact) is pressed, bonded and
+/// pulled apart. It opens uniformly, so its interface follows the rate-independent RCC
+/// limit: peak force A √(C_n w) and work of separation w A (A = 2 m², docs/model.md §6).
+/// Tolerances 1 %: the peak is sampled at the steps (1 % of u_c of pull each), and the
+/// force left at the end of the pull carries 0.25 % of the work.
+#[test]
+fn a_cut_block_bonded_to_itself_pulls_off_at_the_closed_form_peak_and_work() {
+    let (peak_exact, work_exact) = (TOP_AREA * (CUT_CN * CUT_W).sqrt(), CUT_W * TOP_AREA);
+    for (slave, master, solver) in [
+        (
+            &["upper_lip"][..],
+            &["lower_lip"][..],
+            ContactSolver::GaussSeidel,
+        ),
+        (
+            &["lower_lip", "upper_lip"][..],
+            &["lower_lip", "upper_lip"][..],
+            ContactSolver::GaussSeidel,
+        ),
+        (
+            &["lower_lip", "upper_lip"][..],
+            &["lower_lip", "upper_lip"][..],
+            ContactSolver::Semismooth,
+        ),
+    ] {
+        let (peak, work) = cut_block_pull_off(slave, master, solver);
+        eprintln!(
+            "{slave:?} on {master:?}, {solver:?}: peak {peak:.6} N (A √(C_n w) = {peak_exact:.6}), \
+             work {work:.6} J (w A = {work_exact:.6})"
+        );
+        assert!((peak / peak_exact - 1.0).abs() < 0.01, "peak {peak} N");
+        assert!((work / work_exact - 1.0).abs() < 0.01, "work {work} J");
     }
 }

@@ -75,7 +75,59 @@ pub(super) fn build_mesh(m: &FileMesh, key: &str, ctx: &Ctx) -> Result<Mesh, Sce
             )?;
             Ok(generate::quarter_hemisphere(*radius, *n))
         }
+        FileGenerator::Tube {
+            inner,
+            outer,
+            thickness,
+            n_around,
+            n_radial,
+            grip,
+        } => tube(
+            *inner,
+            *outer,
+            *thickness,
+            [*n_around, *n_radial],
+            *grip,
+            key,
+            ctx,
+        ),
     }
+}
+
+/// A tube between the ellipses of semi-axes `inner` and `outer` [m], `thickness` [m] thick,
+/// with `counts` = [n_around, n_radial] elements and the gripped arcs `grip` [m] wide
+/// (default: the outer semi-axis along x).
+fn tube(
+    inner: [f64; 2],
+    outer: [f64; 2],
+    thickness: f64,
+    counts: [usize; 2],
+    grip: Option<f64>,
+    key: &str,
+    ctx: &Ctx,
+) -> Result<Mesh, ScenarioError> {
+    for k in 0..2 {
+        ctx.positive(&format!("{key}.inner[{k}]"), inner[k])?;
+        ctx.positive(&format!("{key}.outer[{k}]"), outer[k])?;
+        if outer[k] <= inner[k] {
+            return Err(ctx.err(format!(
+                "`{key}.outer[{k}]` = {} must exceed `{key}.inner[{k}]` = {}: the outer ellipse encloses the inner one",
+                outer[k], inner[k]
+            )));
+        }
+    }
+    ctx.positive(&format!("{key}.thickness"), thickness)?;
+    let grip = ctx.positive(&format!("{key}.grip"), grip.unwrap_or(outer[0]))?;
+    ctx.count(&format!("{key}.n_around"), counts[0], MAX_DIVISIONS)?;
+    ctx.count(&format!("{key}.n_radial"), counts[1], MAX_DIVISIONS)?;
+    ctx.cell_limit(
+        key,
+        &format!("n_around = {}, n_radial = {}", counts[0], counts[1]),
+        (counts[0] as u128 + 3) * counts[1] as u128,
+    )?;
+    Ok(generate::tube(
+        inner, outer, thickness, counts[0], counts[1], grip,
+    ))
 }
 
 /// A block of `size` [m] cut into `divisions` hexahedra per direction.

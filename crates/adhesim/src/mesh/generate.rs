@@ -187,6 +187,107 @@ pub fn half_disk(
     mesh
 }
 
+/// A tube of elliptic cross-section lying along z: the region between the inner ellipse of
+/// semi-axes `inner` = [a, b] [m] (along x and y) and the outer one `outer` = [A, B] [m],
+/// centred on the z axis, extruded over z ∈ [0, `thickness`] with one element through the
+/// thickness (a plane-strain slab). Equal semi-axes give a circular ring; a flat inner
+/// ellipse (b ≪ a) a channel.
+///
+/// Grid: `n_around` elements around (rounded up to a multiple of 4, so that the points
+/// (±a, 0) and (0, ±b) are nodes) and `n_radial` layers between the ellipses. Node (k, j)
+/// sits at ((a + s(A − a)) cos θ, (b + s(B − b)) sin θ) with θ = 2πk/n_around and
+/// s = j/n_radial, which puts the nodes closer together where the inner ellipse curves
+/// most (at its ends on the x axis).
+///
+/// Face sets: `inner`, `outer`, `front` (z = t), `back` (z = 0); together they cover the
+/// boundary. Node sets (besides those of the face sets): `top_grip` and `bottom_grip`, the
+/// outer surface's nodes with |x| ≤ `grip` / 2 [m] above and below the x axis, where plates
+/// glued to the tube would hold it.
+///
+/// # Panics
+/// If a length is not positive and finite, the outer ellipse does not enclose the inner
+/// one, or a count is zero.
+pub fn tube(
+    inner: [f64; 2],
+    outer: [f64; 2],
+    thickness: f64,
+    n_around: usize,
+    n_radial: usize,
+    grip: f64,
+) -> Mesh {
+    for (what, v) in [
+        ("inner[0]", inner[0]),
+        ("inner[1]", inner[1]),
+        ("outer[0]", outer[0]),
+        ("outer[1]", outer[1]),
+        ("thickness", thickness),
+        ("grip", grip),
+    ] {
+        assert_length("tube", what, v);
+    }
+    assert!(
+        outer[0] > inner[0] && outer[1] > inner[1],
+        "tube: the outer semi-axes must exceed the inner ones"
+    );
+    assert!(
+        n_around > 0 && n_radial > 0,
+        "tube: counts must be at least 1"
+    );
+    let mut mesh = extrude(&tube_plane(inner, outer, n_around, n_radial), thickness);
+    let on_ellipse =
+        |ab: [f64; 2]| move |p: [f64; 3]| ((p[0] / ab[0]).hypot(p[1] / ab[1]) - 1.0).abs() <= 1e-9;
+    let (on_inner, on_outer) = (on_ellipse(inner), on_ellipse(outer));
+    let z_tol = REL_TOL * thickness;
+    let back = move |p: [f64; 3]| p[2].abs() <= z_tol;
+    let front = move |p: [f64; 3]| (p[2] - thickness).abs() <= z_tol;
+    name_boundary_faces(
+        &mut mesh,
+        &[
+            ("inner", &on_inner),
+            ("outer", &on_outer),
+            ("front", &front),
+            ("back", &back),
+        ],
+    );
+    let gripped = |above: bool| -> Vec<usize> {
+        mesh.node_sets["outer"]
+            .iter()
+            .copied()
+            .filter(|&i| {
+                let p = mesh.nodes[i];
+                p[0].abs() <= 0.5 * grip && (p[1] > 0.0) == above
+            })
+            .collect()
+    };
+    let (top, bottom) = (gripped(true), gripped(false));
+    mesh.set_nodes("top_grip", top);
+    mesh.set_nodes("bottom_grip", bottom);
+    mesh
+}
+
+/// The plane grid of [`tube`]: `n_around` (rounded up to a multiple of 4) by `n_radial`
+/// quads, counter-clockwise.
+fn tube_plane(inner: [f64; 2], outer: [f64; 2], n_around: usize, n_radial: usize) -> PlaneMesh {
+    let n = n_around.div_ceil(4) * 4;
+    let id = |k: usize, j: usize| (k % n) * (n_radial + 1) + j;
+    let mut nodes = Vec::with_capacity(n * (n_radial + 1));
+    for k in 0..n {
+        let theta = 2.0 * std::f64::consts::PI * k as f64 / n as f64;
+        for j in 0..=n_radial {
+            let s = j as f64 / n_radial as f64;
+            let a = inner[0] + s * (outer[0] - inner[0]);
+            let b = inner[1] + s * (outer[1] - inner[1]);
+            nodes.push([a * theta.cos(), b * theta.sin()]);
+        }
+    }
+    let quads = (0..n)
+        .flat_map(|k| {
+            (0..n_radial).map(move |j| [id(k, j), id(k, j + 1), id(k + 1, j + 1), id(k + 1, j)])
+        })
+        .collect();
+    PlaneMesh { nodes, quads }
+}
+
 /// Quarter of a solid hemisphere of radius R hanging below the plane y = 0: the ball's
 /// octant x ≥ 0, y ≤ 0, z ≥ 0, curved face down, all hex.
 ///
@@ -879,6 +980,39 @@ mod tests {
     #[should_panic(expected = "disk: radius must be positive")]
     fn disk_rejects_zero_radius() {
         disk(0.0, 0.001, 4, 4);
+    }
+
+    #[test]
+    fn tube_volume_sets_and_grips() {
+        let (inner, outer, t) = ([0.01, 0.002], [0.016, 0.008], 0.001);
+        for (n_around, n_radial) in [(8, 1), (30, 3), (96, 4)] {
+            let m = tube(inner, outer, t, n_around, n_radial, 0.016);
+            check_mesh(&m, &["inner", "outer", "front", "back"], outer[0]);
+            let n = n_around.div_ceil(4) * 4;
+            assert_eq!(m.num_cells(), n * n_radial);
+            // Both rims are affine images of a regular n-gon inscribed in a circle, so the
+            // annulus holds exactly (n/2) sin(2π/n) (AB − ab) t.
+            let polygon = 0.5 * n as f64 * (2.0 * PI / n as f64).sin();
+            let exact = polygon * (outer[0] * outer[1] - inner[0] * inner[1]) * t;
+            assert!(
+                (volume(&m) / exact - 1.0).abs() < 1e-12,
+                "({n_around},{n_radial})"
+            );
+            assert_eq!(m.face_sets["inner"].len(), n);
+            assert_eq!(m.face_sets["outer"].len(), n);
+            let on = |ab: [f64; 2], p: [f64; 3]| {
+                ((p[0] / ab[0]).hypot(p[1] / ab[1]) - 1.0).abs() < 1e-12
+            };
+            assert!(coords(&m, "inner").all(|p| on(inner, p)));
+            assert!(coords(&m, "outer").all(|p| on(outer, p)));
+            for (set, up) in [("top_grip", true), ("bottom_grip", false)] {
+                let pts: Vec<[f64; 3]> = coords(&m, set).collect();
+                assert!(!pts.is_empty(), "{set}");
+                assert!(pts
+                    .iter()
+                    .all(|p| on(outer, *p) && p[0].abs() <= 0.008 && (p[1] > 0.0) == up));
+            }
+        }
     }
 
     #[test]
