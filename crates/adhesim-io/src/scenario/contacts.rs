@@ -12,6 +12,7 @@ use adhesim::contact::{
     ContactPair, InterfaceLaw, Master, PairDiscretisation, RccParams, RigidMotion, RigidShape,
 };
 use adhesim::mesh::Face;
+use std::collections::BTreeMap;
 
 /// The `[[contact]]` pairs in file order, with distinct names.
 pub(super) fn build_contacts(
@@ -143,6 +144,13 @@ impl Slave {
         let sb = bodies.body(&format!("{key}.slave.body"), &s.body, ctx)?;
         let faces = bodies.face_set(&format!("{key}.slave.set"), sb, &s.set, ctx)?;
         let mesh = &bodies.list[sb].mesh;
+        manifold(
+            &faces,
+            &mesh.nodes,
+            &format!("{key}.slave.set"),
+            &s.set,
+            ctx,
+        )?;
         let local_nodes = match mesh.node_sets.get(&s.set) {
             Some(n) => n.clone(),
             None => {
@@ -181,6 +189,40 @@ impl Slave {
             vec![Vec::new(); self.local_nodes.len()]
         }
     }
+}
+
+/// Checks that the contact surface `faces` (of the face set `set`, named at `key`) is a
+/// manifold: no edge between two corners is shared by more than two of its faces (as where
+/// two parts of a body touch along an edge only), since a site's normal and the mortar
+/// segments need one surface on each side of an edge.
+fn manifold(
+    faces: &[Face],
+    nodes: &[[f64; 3]],
+    key: &str,
+    set: &str,
+    ctx: &Ctx,
+) -> Result<(), ScenarioError> {
+    match non_manifold_edge(faces) {
+        None => Ok(()),
+        Some(([a, b], count)) => Err(ctx.err(format!(
+            "`{key}` = {set:?} is not a manifold surface: the edge from {:?} to {:?} is shared by {count} of its faces; a contact surface may have at most two faces at an edge (split the set, or mesh the parts so that they do not meet along an edge only)",
+            nodes[a], nodes[b]
+        ))),
+    }
+}
+
+/// An edge (its two corner nodes, sorted) shared by more than two of `faces`, with the
+/// number of faces sharing it; the first such edge in node order.
+fn non_manifold_edge(faces: &[Face]) -> Option<([usize; 2], usize)> {
+    let mut count: BTreeMap<[usize; 2], usize> = BTreeMap::new();
+    for f in faces {
+        let c = f.corners();
+        for k in 0..c.len() {
+            let (a, b) = (c[k], c[(k + 1) % c.len()]);
+            *count.entry([a.min(b), a.max(b)]).or_default() += 1;
+        }
+    }
+    count.into_iter().find(|&(_, n)| n > 2)
 }
 
 /// Mean length [m] of the faces' edges (0 without faces).
@@ -263,6 +305,13 @@ fn deformable_master(
         return Err(ctx.err(format!("`{key}.motion` applies to rigid masters only; move a deformable master with [[boundary]] conditions")));
     }
     let faces = bodies.face_set(&format!("{key}.master.set"), mb, set, ctx)?;
+    manifold(
+        &faces,
+        &bodies.list[mb].mesh.nodes,
+        &format!("{key}.master.set"),
+        set,
+        ctx,
+    )?;
     let off = bodies.offsets[mb];
     Ok(Master::Faces(
         faces
