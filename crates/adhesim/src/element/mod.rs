@@ -11,18 +11,24 @@
 //!   and the assembly loops are compiled for each type (no dynamic dispatch per element or
 //!   Gauss point).
 //!
-//! The types are trilinear hex8 (2×2×2 Gauss, `hex8.rs`), linear tet4 (1 point, `tet4.rs`)
-//! and quadratic tet10 (4 points, `tet10.rs`).
+//! The types are trilinear hex8 (2×2×2 Gauss, `hex8.rs`), linear tet4 (1 point, `tet4.rs`),
+//! quadratic tet10 (4 points, `tet10.rs`) and quadratic (serendipity) hex20 (3×3×3 points,
+//! `hex20.rs`). Their faces are described by face types (`face.rs`).
 //! Reference-configuration data (shape-function gradients, weights) are computed once; the
 //! kernels turn nodal displacements into internal force, consistent tangent (material +
 //! geometric) and strain energy.
 
 pub mod face;
+pub(crate) mod hex20;
 pub(crate) mod hex8;
 pub(crate) mod tet10;
 pub(crate) mod tet4;
 
 pub use face::{FaceType, LocalFace};
+pub use hex20::{
+    hex20_geometry, hex20_shape, quad8_shape, Hex20, HEX20, HEX20_EDGES, HEX20_NODE_XI, QUAD8,
+    QUAD8_NODE_XI,
+};
 pub use hex8::{
     hex8_centre, hex8_gauss_points, hex8_geometry, hex8_shape, quad4_shape, Hex8, HEX8,
     HEX_NODE_XI, QUAD4,
@@ -60,6 +66,7 @@ element_types! {
     Hex8, 8, 8, HEX8;
     Tet4, 4, 1, TET4;
     Tet10, 10, 4, TET10;
+    Hex20, 20, 27, HEX20;
 }
 
 /// What is done with each element type's Rust type ([`visit_element_types`]).

@@ -16,10 +16,12 @@
 //!    Groups without a name are called `physical_<tag>`.
 //!
 //! Element types: the volume types of the element-type table
-//! ([`crate::element::ELEMENT_TYPES`], found by their Gmsh type number: hex8 (Gmsh type 5)
-//! and tet4 (4)) become cells; quad4 (3) and tri3 (2) are faces; points (15) and lines (1, 8,
-//! 26, 27, 28) only feed node sets. Gmsh's node orders of these types are adhesim's (VTK)
-//! orders, so cells are taken as they are. Other volume or surface elements are rejected.
+//! ([`crate::element::ELEMENT_TYPES`], found by their Gmsh type number: hex8 (Gmsh type 5),
+//! tet4 (4), tet10 (11) and hex20 (17)) become cells, their nodes taken in the order of the
+//! row's `gmsh_nodes` (Gmsh's order is adhesim's (VTK) order for hex8 and tet4; it differs
+//! in the mid-edge nodes of tet10 and hex20); quad4 (3), tri3 (2), tri6 (9) and quad8 (16)
+//! are faces; points (15) and lines (1, 8, 26, 27, 28) only feed node sets. Other volume or
+//! surface elements are rejected, and so is a file mixing first- and second-order volumes.
 
 use super::{Face, Mesh};
 use crate::element::{ElementType, ELEMENT_TYPES};
@@ -156,6 +158,8 @@ pub struct MshFile {
     pub tris: Vec<Element<3>>,
     /// Tri6 elements (faces of tet10 meshes).
     pub tri6s: Vec<Element<6>>,
+    /// Quad8 elements (faces of hex20 meshes), nodes in Gmsh's order, which is adhesim's.
+    pub quad8s: Vec<Element<8>>,
     /// Point (dimension 0) and line (dimension 1) elements: dimension, entity, nodes.
     pub low_dim: Vec<(i32, i32, Vec<usize>)>,
     /// Physical group names by (dimension, tag); unnamed groups are `physical_<tag>`.
@@ -823,7 +827,7 @@ impl Parser<'_> {
                     })
                     .collect();
                 return Err(self.err_at(at_type,
-                    format!("element type {etype} is not known: adhesim reads {} volumes, quad4 (3), tri3 (2) and tri6 (9) faces", volumes.join(", ")),
+                    format!("element type {etype} is not known: adhesim reads {} volumes, quad4 (3), tri3 (2), tri6 (9) and quad8 (16) faces", volumes.join(", ")),
                 ));
             };
             if edim != dim {
@@ -832,7 +836,7 @@ impl Parser<'_> {
                 ));
             }
             let volume = ElementType::from_gmsh(etype);
-            let supported = matches!(etype, 2 | 3 | 9) || volume.is_some() || dim <= 1;
+            let supported = matches!(etype, 2 | 3 | 9 | 16) || volume.is_some() || dim <= 1;
             if !supported {
                 let fix = if matches!(etype, 6 | 7 | 13 | 14 | 18 | 19) {
                     format!(
@@ -841,11 +845,11 @@ impl Parser<'_> {
                     )
                 } else if dim == 3 {
                     format!(
-                        "the volume elements adhesim reads are {}: remesh with first-order elements (Mesh.ElementOrder = 1), or with second-order tetrahedra (Mesh.ElementOrder = 2 on a tetrahedral mesh)",
+                        "the volume elements adhesim reads are {}: remesh with first-order elements (Mesh.ElementOrder = 1), or at second order with Mesh.ElementOrder = 2 and Mesh.SecondOrderIncomplete = 1 (tet10, or 20-node hexahedra without the face and centre nodes)",
                         volume_type_names(", ")
                     )
                 } else {
-                    "adhesim reads quad4, tri3 and tri6 surface elements: remesh with first-order elements (Mesh.ElementOrder = 1), or second-order tetrahedra, whose faces are tri6".to_string()
+                    "adhesim reads quad4, tri3, tri6 and quad8 surface elements: remesh with first-order elements (Mesh.ElementOrder = 1), or at second order with Mesh.SecondOrderIncomplete = 1 (tet10 with tri6 faces, hex20 with quad8 faces)".to_string()
                 };
                 return Err(self.err_at(
                     at_type,
@@ -894,6 +898,11 @@ impl Parser<'_> {
                         nodes: [nodes[0], nodes[1], nodes[2], nodes[3]],
                     }),
                     9 => msh.tri6s.push(Element {
+                        tag,
+                        entity,
+                        nodes: std::array::from_fn(|k| nodes[k]),
+                    }),
+                    16 => msh.quad8s.push(Element {
                         tag,
                         entity,
                         nodes: std::array::from_fn(|k| nodes[k]),
@@ -1103,7 +1112,8 @@ impl MshFile {
             .iter()
             .map(|e| (e.tag, e.entity, &e.nodes[..]))
             .chain(self.tris.iter().map(|e| (e.tag, e.entity, &e.nodes[..])))
-            .chain(self.tri6s.iter().map(|e| (e.tag, e.entity, &e.nodes[..])));
+            .chain(self.tri6s.iter().map(|e| (e.tag, e.entity, &e.nodes[..])))
+            .chain(self.quad8s.iter().map(|e| (e.tag, e.entity, &e.nodes[..])));
         for (tag, entity, nodes) in surface {
             if self.groups(2, entity).next().is_none()
                 || nodes.iter().any(|&i| new_id[i] == usize::MAX)
@@ -1326,9 +1336,10 @@ $EndElements
         let e = parse_str(&CUBE.replace("1 1 0\n0 1 0", "1 1 0\n0 nan 0")).unwrap_err();
         assert_eq!(e.location, Some(Location::Line(28)), "{e}");
         assert!(e.to_string().starts_with("cube.msh:28: "), "{e}");
-        let e = parse_str(&CUBE.replace("3 1 5 1", "3 1 17 1")).unwrap_err();
+        let e = parse_str(&CUBE.replace("3 1 5 1", "3 1 12 1")).unwrap_err();
         assert!(
-            e.message.contains("hex20 (Gmsh type 17) is not supported"),
+            e.message.contains("hex27 (Gmsh type 12) is not supported")
+                && e.message.contains("SecondOrderIncomplete"),
             "{e}"
         );
         let e = parse_str(&CUBE.replace("1 2 3 4 5 6 7 8\n", "1 2 3 4 5 6 7 9\n")).unwrap_err();

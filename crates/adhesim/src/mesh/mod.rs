@@ -17,7 +17,10 @@
 use std::collections::BTreeMap;
 
 use crate::element::face::MAX_FACE_NODES;
-use crate::element::{ElementType, FaceType, LocalFace, HEX8, QUAD4, TET10, TET4, TRI3, TRI6};
+use crate::element::{
+    ElementType, FaceType, LocalFace, HEX20, HEX20_EDGES, HEX8, QUAD4, QUAD8, TET10, TET10_EDGES,
+    TET4, TRI3, TRI6,
+};
 
 pub mod generate;
 pub mod gmsh;
@@ -350,18 +353,18 @@ impl Mesh {
 }
 
 impl Mesh {
-    /// The same tetrahedral body with second-order tetrahedra: a node at the middle of every
-    /// edge (shared by the cells around it), each tet4 becoming a straight-sided tet10; face
-    /// sets become six-node triangles and node sets take the mid-side nodes of edges whose
-    /// ends are both in the set. Hexahedra are split first ([`Mesh::split_hexes_into_tets`]).
+    /// The same body with second-order cells: a node at the middle of every edge (shared by
+    /// the cells around it), each tet4 becoming a straight-sided tet10 and each hex8 a
+    /// straight-sided hex20; face sets become six-node triangles and eight-node
+    /// quadrilaterals, and node sets take the mid-side nodes of edges whose ends are both in
+    /// the set. (For tet10 from a hexahedral mesh, split it first:
+    /// [`Mesh::split_hexes_into_tets`].)
+    ///
+    /// # Panics
+    /// The mesh already holds second-order cells.
     pub fn with_mid_side_nodes(&self) -> Mesh {
-        let tets = if self.hexes().is_empty() {
-            self.clone()
-        } else {
-            self.split_hexes_into_tets()
-        };
         let mut out = Mesh {
-            nodes: tets.nodes.clone(),
+            nodes: self.nodes.clone(),
             ..Default::default()
         };
         let mut mid: std::collections::HashMap<(usize, usize), usize> =
@@ -374,17 +377,20 @@ impl Mesh {
                 nodes.len() - 1
             })
         };
-        let mut cells = Vec::with_capacity(tets.tets().len());
-        for t in tets.tets() {
-            let mut c = [0usize; 10];
-            c[..4].copy_from_slice(t);
-            for (m, [i, j]) in crate::element::tet10::TET10_EDGES.iter().enumerate() {
-                c[4 + m] = mid_of(t[*i], t[*j], &mut out.nodes);
+        for block in &self.blocks {
+            let (quadratic, edges) = second_order_of(block.element);
+            let mut cells =
+                Vec::with_capacity(block.connectivity.len() + block.len() * edges.len());
+            for t in block.cells() {
+                cells.extend_from_slice(t);
+                for [i, j] in edges {
+                    let m = mid_of(t[*i], t[*j], &mut out.nodes);
+                    cells.push(m);
+                }
             }
-            cells.push(c);
+            out.connectivity_mut(quadratic).extend(cells);
         }
-        out.add_cells(&TET10, cells);
-        for (name, ids) in &tets.node_sets {
+        for (name, ids) in &self.node_sets {
             let inside: std::collections::HashSet<usize> = ids.iter().copied().collect();
             let mut with_mids = ids.clone();
             with_mids.extend(
@@ -394,18 +400,33 @@ impl Mesh {
             );
             out.set_nodes(name, with_mids);
         }
-        for (name, faces) in &tets.face_sets {
+        for (name, faces) in &self.face_sets {
             let quadratic = faces
                 .iter()
                 .map(|f| {
-                    let n = f.nodes();
+                    let n = f.corners();
                     let m = |a: usize, b: usize| mid[&(n[a].min(n[b]), n[a].max(n[b]))];
-                    Face::new(&TRI6, &[n[0], n[1], n[2], m(0, 1), m(1, 2), m(2, 0)])
+                    let mut with_mids = n.to_vec();
+                    with_mids.extend((0..n.len()).map(|k| m(k, (k + 1) % n.len())));
+                    let face_type = if n.len() == 3 { &TRI6 } else { &QUAD8 };
+                    Face::new(face_type, &with_mids)
                 })
                 .collect();
             out.face_sets.insert(name.clone(), quadratic);
         }
         out
+    }
+}
+
+/// The second-order type of the first-order `element` (tet10 of tet4, hex20 of hex8) and the
+/// corner pairs of its mid-edge nodes, in its node order.
+fn second_order_of(element: &ElementType) -> (&'static ElementType, &'static [[usize; 2]]) {
+    if *element == TET4 {
+        (&TET10, &TET10_EDGES)
+    } else if *element == HEX8 {
+        (&HEX20, &HEX20_EDGES)
+    } else {
+        panic!("{} cells have mid-side nodes already", element.name)
     }
 }
 
