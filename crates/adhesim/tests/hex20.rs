@@ -454,3 +454,83 @@ fn node_to_surface_between_bodies_is_refused_on_eight_node_faces() {
     assert!((total - 2.1).abs() < 1e-12, "{total}");
     assert!(pair.slave_area.iter().all(|&a| a > 0.0));
 }
+
+/// The contact patch test of tests/contact_patch.rs on hex20 blocks (Gmsh,
+/// tests/data/patch_hex20.msh): a 1 × 0.5 × 1 m linear elastic block (E = 1 MPa, ν = 0.3) of
+/// 3 × 2 × 3 cells under one of 4 × 2 × 4 cells (or the other way round), frictionless
+/// mortar contact between their eight-node faces, symmetry on x = 0 and z = 0, the top
+/// pushed down by 1 mm: the exact answer is a uniform pressure E δ / H = 1000 Pa.
+fn hex20_patch(upper: &str, lower: &str) -> (f64, f64) {
+    let offset = |block: &str| if block == "fine" { -2.0 } else { 0.0 };
+    let body = |name: &str, block: &str, y: f64| {
+        format!(
+            r#"
+[[body]]
+name = "{name}"
+mesh = {{ file = "patch_hex20.msh", volumes = ["{block}"] }}
+material = {{ model = "linear-elastic", young = 1e6, poisson = 0.3 }}
+density = 1000.0
+offset = [{}, {y}, 0.0]
+"#,
+            offset(block)
+        )
+    };
+    let fix = |name: &str, set: &str, fix: &str| {
+        format!("[[boundary]]\nbody = \"{name}\"\nset = \"{set}\"\nfix = [{fix}]\n")
+    };
+    let mut text = String::from(
+        "[time]\nt_end = 1.0\ndt = 1.0\nmode = \"quasi-static\"\nnewton_tol = 1e-12\ncontact_tol = 1e-12\n",
+    );
+    text += &body("lower", lower, 0.0);
+    text += &body("upper", upper, 0.5);
+    text += &fix("lower", &format!("{lower}_bottom"), "\"y\"");
+    for (name, block) in [("lower", lower), ("upper", upper)] {
+        text += &fix(name, &format!("{block}_left"), "\"x\"");
+        text += &fix(name, &format!("{block}_back"), "\"z\"");
+    }
+    text += &fix("upper", &format!("{upper}_top"), "");
+    text += "displacement = { y = [[0.0, 0.0], [1.0, -1e-3]] }\n";
+    text += &format!(
+        r#"[[contact]]
+name = "interface"
+slave = {{ body = "upper", set = "{upper}_bottom" }}
+master = {{ body = "lower", set = "{lower}_top" }}
+friction = 0.0
+detection_distance = 0.01
+discretisation = "mortar"
+"#
+    );
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/patch_hex20.toml");
+    let problem = adhesim_io::scenario::parse(&text, &path).unwrap().problem;
+    let pair = problem.contacts[0].clone();
+    let mut s = adhesim::time::Stepper::new(Arc::new(problem)).unwrap();
+    while !s.finished() {
+        s.step().unwrap();
+    }
+    let sites = &s.contact[0];
+    let force: f64 = sites.iter().map(|c| c.force[1]).sum();
+    let worst = sites
+        .iter()
+        .zip(&pair.slave_area)
+        .map(|(c, a)| ((c.force[1] / a) - 1000.0).abs() / 1000.0)
+        .fold(0.0, f64::max);
+    (worst, force)
+}
+
+#[test]
+fn mortar_on_eight_node_faces_passes_the_contact_patch_test() {
+    for (upper, lower) in [("fine", "coarse"), ("coarse", "fine")] {
+        let (worst, force) = hex20_patch(upper, lower);
+        eprintln!(
+            "hex20 mortar patch, {upper} on {lower}: pressure error {worst:.1e}, force {force:.10} N"
+        );
+        assert!(
+            worst < 1e-6,
+            "{upper} on {lower}: pressure off by {worst:e}"
+        );
+        assert!(
+            (force - 1000.0).abs() < 1e-8 * 1000.0,
+            "{upper} on {lower}: {force}"
+        );
+    }
+}
