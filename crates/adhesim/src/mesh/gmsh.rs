@@ -1352,6 +1352,21 @@ $EndElements
         }
     }
 
+    /// A hex8 and a hex20 in one file: refused, naming both types.
+    #[test]
+    fn mixed_orders_are_refused_naming_the_types() {
+        let mixed = CUBE.replace("2 2 1 2\n", "3 3 1 3\n").replace(
+            "$EndElements",
+            "3 1 17 1\n3 1 2 3 4 5 6 7 8 1 2 3 4 5 6 7 8 1 2 3 4\n$EndElements",
+        );
+        let e = parse_str(&mixed).unwrap_err();
+        assert!(
+            e.message.contains("mixes first- and second-order")
+                && e.message.contains("hex8 and hex20"),
+            "{e}"
+        );
+    }
+
     #[test]
     fn selection_by_physical_volume() {
         let msh = parse_str(CUBE).unwrap();
