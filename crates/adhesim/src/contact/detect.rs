@@ -509,12 +509,7 @@ pub fn frame_from_normal(n: [f64; 3]) -> [[f64; 3]; 3] {
 
 /// `a` scaled to unit length; e_y for the zero vector.
 pub(super) fn unit(a: Vec3) -> Vec3 {
-    let n = a.norm();
-    if n > 0.0 {
-        a / n
-    } else {
-        Vec3::y()
-    }
+    crate::element::face::unit(a)
 }
 
 #[cfg(test)]

@@ -1,7 +1,7 @@
 //! Meshes: nodes, cell blocks, named node and face sets. No physics here.
 //!
 //! The cells are kept in blocks, one per element type of [`crate::element::ELEMENT_TYPES`]
-//! in the table's order (hex8, then tet4), each a flat connectivity list. A cell's index in
+//! in the table's order (hex8, tet4, tet10, hex20), each a flat connectivity list. A cell's index in
 //! the mesh counts through the blocks in that order.
 //!
 //! Conventions
@@ -10,6 +10,8 @@
 //!   (−1,−1,−1), (1,−1,−1), (1,1,−1), (−1,1,−1), (−1,−1,1), (1,−1,1), (1,1,1), (−1,1,1)).
 //!   A valid hex has positive Jacobian determinant at all its Gauss points.
 //! - Tet4 cells use the VTK order; (x1−x0)·((x2−x0)×(x3−x0)) > 0.
+//! - Tet10 and hex20 cells use the VTK orders: the corners as for tet4 and hex8, then the
+//!   mid-edge nodes ([`crate::element::TET10_EDGES`], [`crate::element::HEX20_EDGES`]).
 //! - Boundary faces are listed counter-clockwise seen from outside the body, so that the
 //!   right-hand-rule normal points out of the body. A face is its face type (one of
 //!   [`crate::element::face`], named by the element type it bounds) and its nodes.
