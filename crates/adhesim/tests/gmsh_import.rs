@@ -55,8 +55,7 @@ fn ascii_and_binary_files_give_the_same_mesh() {
     assert_eq!(a.nodes, b.nodes);
     assert_eq!(a.node_tags, b.node_tags);
     assert_eq!(a.volumes, b.volumes);
-    assert_eq!(a.quads, b.quads);
-    assert_eq!(a.tris, b.tris);
+    assert_eq!(a.surfaces, b.surfaces);
     assert_eq!(a.physical_names, b.physical_names);
     assert_eq!(a.body(None).unwrap(), b.body(None).unwrap());
 }

@@ -48,6 +48,9 @@ pub struct FaceType {
     pub quadrature: fn() -> Vec<([f64; 2], f64)>,
     /// VTK cell type number for drawing the face.
     pub vtk_type: u8,
+    /// Gmsh element type number (MSH 4.1) of the face as a surface element; Gmsh lists its
+    /// nodes in the face type's order.
+    pub gmsh_type: i32,
     /// Whether the face is of second order (has mid-side nodes).
     pub is_quadratic: bool,
     /// The closest point to `x` [m] on the face with node positions `p` [m], kept on the
@@ -77,6 +80,27 @@ impl std::hash::Hash for FaceType {
 }
 
 impl FaceType {
+    /// The face types of the element types of [`super::ELEMENT_TYPES`], each once, in the
+    /// order of the table (quad4, tri3, tri6, quad8).
+    pub fn all() -> Vec<&'static FaceType> {
+        let mut out: Vec<&'static FaceType> = Vec::new();
+        for t in super::ELEMENT_TYPES {
+            for f in t.faces {
+                if !out.contains(&f.face_type) {
+                    out.push(f.face_type);
+                }
+            }
+        }
+        out
+    }
+
+    /// The face type of Gmsh element type number `gmsh_type`, if adhesim has it.
+    pub fn from_gmsh(gmsh_type: i32) -> Option<&'static FaceType> {
+        FaceType::all()
+            .into_iter()
+            .find(|t| t.gmsh_type == gmsh_type)
+    }
+
     /// Whether the face's shape functions at a point of piece `piece` are the piece's own
     /// linear (bilinear) weights: the piece is the whole face.
     pub fn piece_is_face(&self, piece: &[usize]) -> bool {

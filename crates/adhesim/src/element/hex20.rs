@@ -208,6 +208,7 @@ pub static QUAD8: FaceType = FaceType {
     },
     quadrature: || square_quadrature(3),
     vtk_type: 23,
+    gmsh_type: 16,
     is_quadratic: true,
     project: project_on_quad8,
 };

@@ -23,6 +23,7 @@ pub static QUAD4: FaceType = FaceType {
     },
     quadrature: || square_quadrature(2),
     vtk_type: 9,
+    gmsh_type: 3,
     is_quadratic: false,
     project: project_on_quad4,
 };

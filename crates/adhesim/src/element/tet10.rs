@@ -34,6 +34,7 @@ pub static TRI6: FaceType = FaceType {
     },
     quadrature: triangle_quadrature,
     vtk_type: 22,
+    gmsh_type: 9,
     is_quadratic: true,
     project: project_on_tri6,
 };

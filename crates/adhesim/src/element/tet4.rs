@@ -23,6 +23,7 @@ pub static TRI3: FaceType = FaceType {
     },
     quadrature: triangle_quadrature,
     vtk_type: 5,
+    gmsh_type: 2,
     is_quadratic: false,
     project: project_on_tri3,
 };

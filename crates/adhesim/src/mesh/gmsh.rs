@@ -24,7 +24,7 @@
 //! surface elements are rejected, and so is a file mixing first- and second-order volumes.
 
 use super::{Face, Mesh};
-use crate::element::{ElementType, ELEMENT_TYPES};
+use crate::element::{ElementType, FaceType, ELEMENT_TYPES};
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -66,16 +66,16 @@ impl std::error::Error for GmshError {}
 /// Dimension and tag of a physical group.
 pub type PhysicalKey = (i32, i32);
 
-/// One element of the file: its Gmsh tag, the geometric entity holding it and its nodes
-/// (indices into [`MshFile::nodes`]).
+/// One surface element of the file: its Gmsh tag, the geometric surface holding it and its
+/// nodes (indices into [`MshFile::nodes`]).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Element<const N: usize> {
+pub struct SurfaceElement {
     /// Gmsh element tag.
     pub tag: u64,
-    /// Tag of the geometric entity (of the element's dimension) that holds it.
+    /// Tag of the geometric surface that holds it.
     pub entity: i32,
-    /// Node indices into [`MshFile::nodes`].
-    pub nodes: [usize; N],
+    /// Node indices into [`MshFile::nodes`], in the face type's order.
+    pub nodes: Vec<usize>,
 }
 
 /// The volume elements of one type in file order: Gmsh tag, entity and nodes of each.
@@ -140,6 +140,42 @@ impl MshFile {
     }
 }
 
+/// The surface elements of one face type in file order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SurfaceElements {
+    /// The face type.
+    pub face_type: &'static FaceType,
+    /// The elements, in file order.
+    pub elements: Vec<SurfaceElement>,
+}
+
+impl MshFile {
+    /// The block of surface elements of `face_type`, created (in face-type order) when
+    /// missing.
+    fn surface_block_mut(&mut self, face_type: &'static FaceType) -> &mut SurfaceElements {
+        let order = |t: &FaceType| FaceType::all().iter().position(|f| *f == t);
+        let i = match self.surfaces.iter().position(|b| b.face_type == face_type) {
+            Some(i) => i,
+            None => {
+                let at = self
+                    .surfaces
+                    .iter()
+                    .position(|b| order(b.face_type) > order(face_type))
+                    .unwrap_or(self.surfaces.len());
+                self.surfaces.insert(
+                    at,
+                    SurfaceElements {
+                        face_type,
+                        elements: Vec::new(),
+                    },
+                );
+                at
+            }
+        };
+        &mut self.surfaces[i]
+    }
+}
+
 /// The content of an MSH 4.1 file that adhesim uses.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MshFile {
@@ -152,14 +188,10 @@ pub struct MshFile {
     /// Volume elements, one block per element type in the order of
     /// [`crate::element::ELEMENT_TYPES`] (no empty blocks).
     pub volumes: Vec<VolumeElements>,
-    /// Quad4 elements.
-    pub quads: Vec<Element<4>>,
-    /// Tri3 elements.
-    pub tris: Vec<Element<3>>,
-    /// Tri6 elements (faces of tet10 meshes).
-    pub tri6s: Vec<Element<6>>,
-    /// Quad8 elements (faces of hex20 meshes), nodes in Gmsh's order, which is adhesim's.
-    pub quad8s: Vec<Element<8>>,
+    /// Surface elements of the face types adhesim has ([`FaceType::all`]), one block per
+    /// face type in that order (no empty blocks), nodes in Gmsh's order, which is the face
+    /// type's.
+    pub surfaces: Vec<SurfaceElements>,
     /// Point (dimension 0) and line (dimension 1) elements: dimension, entity, nodes.
     pub low_dim: Vec<(i32, i32, Vec<usize>)>,
     /// Physical group names by (dimension, tag); unnamed groups are `physical_<tag>`.
@@ -367,6 +399,22 @@ fn volume_type_names(sep: &str) -> String {
         .map(|t| t.name)
         .collect::<Vec<_>>()
         .join(sep)
+}
+
+/// The names of the face types adhesim reads, the last two joined by `last` (with their Gmsh
+/// type numbers when `numbers`).
+fn face_type_names(last: &str, numbers: bool) -> String {
+    let names: Vec<String> = FaceType::all()
+        .iter()
+        .map(|t| match numbers {
+            true => format!("{} ({})", t.name, t.gmsh_type),
+            false => t.name.to_string(),
+        })
+        .collect();
+    match names.split_last() {
+        Some((end, rest)) if !rest.is_empty() => format!("{}{last}{end}", rest.join(", ")),
+        _ => names.join(""),
+    }
 }
 
 fn element_type(t: i32) -> Option<(&'static str, usize, i32)> {
@@ -826,8 +874,13 @@ impl Parser<'_> {
                         }
                     })
                     .collect();
-                return Err(self.err_at(at_type,
-                    format!("element type {etype} is not known: adhesim reads {} volumes, quad4 (3), tri3 (2), tri6 (9) and quad8 (16) faces", volumes.join(", ")),
+                return Err(self.err_at(
+                    at_type,
+                    format!(
+                        "element type {etype} is not known: adhesim reads {} volumes, {} faces",
+                        volumes.join(", "),
+                        face_type_names(" and ", true)
+                    ),
                 ));
             };
             if edim != dim {
@@ -836,7 +889,8 @@ impl Parser<'_> {
                 ));
             }
             let volume = ElementType::from_gmsh(etype);
-            let supported = matches!(etype, 2 | 3 | 9 | 16) || volume.is_some() || dim <= 1;
+            let surface = FaceType::from_gmsh(etype);
+            let supported = volume.is_some() || surface.is_some() || dim <= 1;
             if !supported {
                 let fix = if matches!(etype, 6 | 7 | 13 | 14 | 18 | 19) {
                     format!(
@@ -849,7 +903,7 @@ impl Parser<'_> {
                         volume_type_names(", ")
                     )
                 } else {
-                    "adhesim reads quad4, tri3, tri6 and quad8 surface elements: remesh with first-order elements (Mesh.ElementOrder = 1), or at second order with Mesh.SecondOrderIncomplete = 1 (tet10 with tri6 faces, hex20 with quad8 faces)".to_string()
+                    format!("adhesim reads {} surface elements: remesh with first-order elements (Mesh.ElementOrder = 1), or at second order with Mesh.SecondOrderIncomplete = 1 (tet10 with tri6 faces, hex20 with quad8 faces)", face_type_names(" and ", false))
                 };
                 return Err(self.err_at(
                     at_type,
@@ -886,27 +940,16 @@ impl Parser<'_> {
                         .extend(element.gmsh_nodes.iter().map(|&g| nodes[g]));
                     continue;
                 }
+                if let Some(face_type) = surface {
+                    let block = msh.surface_block_mut(face_type);
+                    block.elements.push(SurfaceElement {
+                        tag,
+                        entity,
+                        nodes: nodes.clone(),
+                    });
+                    continue;
+                }
                 match etype {
-                    2 => msh.tris.push(Element {
-                        tag,
-                        entity,
-                        nodes: [nodes[0], nodes[1], nodes[2]],
-                    }),
-                    3 => msh.quads.push(Element {
-                        tag,
-                        entity,
-                        nodes: [nodes[0], nodes[1], nodes[2], nodes[3]],
-                    }),
-                    9 => msh.tri6s.push(Element {
-                        tag,
-                        entity,
-                        nodes: std::array::from_fn(|k| nodes[k]),
-                    }),
-                    16 => msh.quad8s.push(Element {
-                        tag,
-                        entity,
-                        nodes: std::array::from_fn(|k| nodes[k]),
-                    }),
                     _ => {
                         // Points and lines: only their end nodes matter (node sets).
                         let used = if dim == 0 { 1 } else { 2 };
@@ -1108,12 +1151,9 @@ impl MshFile {
         let owners = mesh.cell_faces();
         let mut faces: BTreeMap<String, (Vec<Face>, Vec<usize>)> = BTreeMap::new();
         let surface = self
-            .quads
+            .surfaces
             .iter()
-            .map(|e| (e.tag, e.entity, &e.nodes[..]))
-            .chain(self.tris.iter().map(|e| (e.tag, e.entity, &e.nodes[..])))
-            .chain(self.tri6s.iter().map(|e| (e.tag, e.entity, &e.nodes[..])))
-            .chain(self.quad8s.iter().map(|e| (e.tag, e.entity, &e.nodes[..])));
+            .flat_map(|b| b.elements.iter().map(|e| (e.tag, e.entity, &e.nodes[..])));
         for (tag, entity, nodes) in surface {
             if self.groups(2, entity).next().is_none()
                 || nodes.iter().any(|&i| new_id[i] == usize::MAX)
