@@ -156,6 +156,8 @@ pub enum Cells {
     Tet4,
     /// The tetrahedra with a node at the middle of each edge.
     Tet10,
+    /// The hexahedra with a node at the middle of each edge.
+    Hex20,
 }
 
 impl Cells {
@@ -165,7 +167,8 @@ impl Cells {
         match self {
             Cells::Hex8 => hexes,
             Cells::Tet4 => hexes.split_hexes_into_tets(),
-            Cells::Tet10 => hexes.with_mid_side_nodes(),
+            Cells::Tet10 => hexes.split_hexes_into_tets().with_mid_side_nodes(),
+            Cells::Hex20 => hexes.with_mid_side_nodes(),
         }
     }
 }

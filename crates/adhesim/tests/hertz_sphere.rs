@@ -601,8 +601,8 @@ fn paraboloid_octant(c: f64, k: usize, a: f64) -> Mesh {
     }
     for faces in mesh.face_sets.values_mut() {
         for f in faces.iter_mut() {
-            if let Face::Quad([a0, a1, a2, a3]) = *f {
-                *f = Face::Quad([a0, a3, a2, a1]);
+            if let &[a0, a1, a2, a3] = f.nodes() {
+                *f = Face::quad([a0, a3, a2, a1]);
             }
         }
     }

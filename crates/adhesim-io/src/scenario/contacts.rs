@@ -11,8 +11,24 @@ use adhesim::contact::rcc::DEFAULT_BETA_EPS;
 use adhesim::contact::{
     ContactPair, InterfaceLaw, Master, PairDiscretisation, RccParams, RigidMotion, RigidShape,
 };
+use adhesim::element::{FaceType, ELEMENT_TYPES};
 use adhesim::mesh::Face;
 use std::collections::BTreeMap;
+
+/// The type of the first second-order face of `faces`, if any.
+fn quadratic_face_type(faces: &[Face]) -> Option<&'static FaceType> {
+    faces.iter().map(Face::face_type).find(|t| t.is_quadratic)
+}
+
+/// The names of the element types that have faces of type `face_type`, joined by "or".
+fn element_types_with(face_type: &FaceType) -> String {
+    let names: Vec<&str> = ELEMENT_TYPES
+        .iter()
+        .filter(|t| t.faces.iter().any(|f| f.face_type == face_type))
+        .map(|t| t.name)
+        .collect();
+    names.join(" or ")
+}
 
 /// The `[[contact]]` pairs in file order, with distinct names.
 pub(super) fn build_contacts(
@@ -52,16 +68,20 @@ fn build_contact(
     let slave = Slave::build(&c.slave, key, bodies, ctx)?;
     let discretisation = build_discretisation(c, key, ctx)?;
     let master = build_master(c, key, slave.body, discretisation, bodies, ctx)?;
-    let quadratic_master = matches!(&master, Master::Faces(f) if f.iter().any(Face::is_quadratic));
-    let deformable_master = matches!(&master, Master::Faces(_));
-    if discretisation != PairDiscretisation::Mortar
-        && deformable_master
-        && (slave.quadratic || quadratic_master)
-    {
-        let side = if slave.quadratic { "slave" } else { "master" };
-        return Err(ctx.err(format!(
-            "`{key}.{side}.set` holds second-order faces (tri6, of tet10 elements); between two bodies node-to-surface contact does not pass the contact patch test with them: set `{key}.discretisation = \"mortar\"`"
-        )));
+    let quadratic_master = match &master {
+        Master::Faces(f) => quadratic_face_type(f),
+        Master::Rigid { .. } => None,
+    };
+    if discretisation != PairDiscretisation::Mortar && matches!(master, Master::Faces(_)) {
+        let found =
+            (slave.quadratic.map(|t| ("slave", t))).or(quadratic_master.map(|t| ("master", t)));
+        if let Some((side, t)) = found {
+            return Err(ctx.err(format!(
+                "`{key}.{side}.set` holds second-order faces ({}, of {} elements); between two bodies node-to-surface contact does not pass the contact patch test with them: set `{key}.discretisation = \"mortar\"`",
+                t.name,
+                element_types_with(t)
+            )));
+        }
     }
     let mu = c.friction;
     if !(mu.is_finite() && mu >= 0.0) {
@@ -132,8 +152,8 @@ struct Slave {
     /// The slave faces with indices into the slave nodes; faces with a node outside the
     /// slave nodes are left out.
     faces: Vec<Face>,
-    /// Whether the face set holds second-order faces.
-    quadratic: bool,
+    /// The type of the face set's first second-order face, if it has one.
+    quadratic: Option<&'static FaceType>,
     /// Mean edge length [m] of the slave faces.
     mean_edge: f64,
 }
@@ -161,7 +181,7 @@ impl Slave {
             }
         };
         let area = tributary_areas(&faces, &mesh.nodes, &local_nodes);
-        let quadratic = faces.iter().any(Face::is_quadratic);
+        let quadratic = quadratic_face_type(&faces);
         let faces_local = local_faces(&faces, &local_nodes);
         let nodes = local_nodes.iter().map(|n| n + bodies.offsets[sb]).collect();
         let mean_edge = mean_edge(&faces, &mesh.nodes);
@@ -316,11 +336,7 @@ fn deformable_master(
     Ok(Master::Faces(
         faces
             .into_iter()
-            .map(|f| match f {
-                Face::Quad(n) => Face::Quad(n.map(|i| i + off)),
-                Face::Tri(n) => Face::Tri(n.map(|i| i + off)),
-                Face::Tri6(n) => Face::Tri6(n.map(|i| i + off)),
-            })
+            .map(|f| f.map_nodes(|i| i + off))
             .collect(),
     ))
 }

@@ -5,7 +5,6 @@
 
 use super::anisotropic::aligned_frame;
 use super::law::InterfaceLaw;
-use super::polygon::quad_shape;
 use crate::mesh::Face;
 use crate::prescribed::{rotate, Rotation, Table};
 use crate::Vec3;
@@ -156,7 +155,7 @@ pub fn local_faces(faces: &[Face], nodes: &[usize]) -> Vec<Face> {
         .iter()
         .filter_map(|f| {
             let m: Option<Vec<usize>> = f.nodes().iter().map(|n| index.get(n).copied()).collect();
-            m.map(|m| Face::of_cell(&m, &(0..m.len()).collect::<Vec<_>>()))
+            m.map(|m| Face::new(f.face_type(), &m))
         })
         .collect()
 }
@@ -401,121 +400,16 @@ pub fn rigid_projection(shape: &RigidShape, x: [f64; 3]) -> ([f64; 3], [f64; 3],
     }
 }
 
-/// Closest-point projection of `x` on a face (bilinear quad by Newton in (ξ, η), clamped to
-/// the face; linear triangle in closed form); returns the point, the face's unit normal
-/// there and the nodal weights.
+/// Closest-point projection of `x` on a face by its face type's projection
+/// ([`crate::element::FaceType::project`]), kept on the face; returns the point, the face's
+/// unit normal there and the nodal weights.
 pub fn project_on_face(
     face: &Face,
     pos: &dyn Fn(usize) -> [f64; 3],
     x: [f64; 3],
 ) -> ([f64; 3], [f64; 3], Vec<f64>) {
-    match face {
-        Face::Quad(ns) => {
-            let p: [[f64; 3]; 4] = ns.map(pos);
-            let (mut a, mut b) = (0.0f64, 0.0f64);
-            let eval = |a: f64, b: f64| {
-                let w = quad_shape(a, b);
-                let da = [
-                    -0.25 * (1.0 - b),
-                    0.25 * (1.0 - b),
-                    0.25 * (1.0 + b),
-                    -0.25 * (1.0 + b),
-                ];
-                let db = [
-                    -0.25 * (1.0 - a),
-                    -0.25 * (1.0 + a),
-                    0.25 * (1.0 + a),
-                    0.25 * (1.0 - a),
-                ];
-                let comb = |c: [f64; 4]| -> Vec3 {
-                    Vec3::from_fn(|k, _| (0..4).map(|i| c[i] * p[i][k]).sum())
-                };
-                (w, comb(w), comb(da), comb(db))
-            };
-            for _ in 0..20 {
-                let (_, xm, ta, tb) = eval(a, b);
-                let r = Vec3::from(x) - xm;
-                // Gauss-Newton on ‖x − x(ξ,η)‖².
-                let (g1, g2) = (r.dot(&ta), r.dot(&tb));
-                let (m11, m12, m22) = (ta.dot(&ta), ta.dot(&tb), tb.dot(&tb));
-                let det = m11 * m22 - m12 * m12;
-                if !(det > 0.0) {
-                    break;
-                }
-                let da = (m22 * g1 - m12 * g2) / det;
-                let db = (m11 * g2 - m12 * g1) / det;
-                a = (a + da).clamp(-1.0, 1.0);
-                b = (b + db).clamp(-1.0, 1.0);
-                if da.abs() + db.abs() < 1e-12 {
-                    break;
-                }
-            }
-            let (w, xm, ta, tb) = eval(a, b);
-            let n = unit(ta.cross(&tb));
-            (xm.into(), n.into(), w.to_vec())
-        }
-        Face::Tri(ns) => {
-            let p: [[f64; 3]; 3] = ns.map(pos);
-            let [p0, p1, p2] = p.map(Vec3::from);
-            let (e1, e2) = (p1 - p0, p2 - p0);
-            let n: [f64; 3] = unit(e1.cross(&e2)).into();
-            let r = Vec3::from(x) - p0;
-            let (m11, m12, m22) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
-            let (g1, g2) = (r.dot(&e1), r.dot(&e2));
-            let det = m11 * m22 - m12 * m12;
-            let mut a = (m22 * g1 - m12 * g2) / det;
-            let mut b = (m11 * g2 - m12 * g1) / det;
-            a = a.max(0.0);
-            b = b.max(0.0);
-            let s = a + b;
-            if s > 1.0 {
-                a /= s;
-                b /= s;
-            }
-            let w = vec![1.0 - a - b, a, b];
-            let xm = std::array::from_fn(|k| w[0] * p[0][k] + w[1] * p[1][k] + w[2] * p[2][k]);
-            (xm, n, w)
-        }
-        Face::Tri6(ns) => project_on_tri6(&ns.map(|n| Vec3::from(pos(n))), Vec3::from(x)),
-    }
-}
-
-/// Closest-point projection of `x` on a six-node triangle with nodes `p` by Gauss-Newton in
-/// its natural coordinates (ξ, η), kept in the triangle; returns the point, the unit normal
-/// there and the nodal weights.
-fn project_on_tri6(p: &[Vec3; 6], x: Vec3) -> ([f64; 3], [f64; 3], Vec<f64>) {
-    let eval = |a: f64, b: f64| {
-        let (w, dw) = crate::element::tri6_shape(a, b);
-        let comb = |c: &dyn Fn(usize) -> f64| -> Vec3 { (0..6).map(|i| c(i) * p[i]).sum() };
-        (w, comb(&|i| w[i]), comb(&|i| dw[i][0]), comb(&|i| dw[i][1]))
-    };
-    let (mut a, mut b) = (1.0 / 3.0, 1.0 / 3.0);
-    for _ in 0..20 {
-        let (_, xm, ta, tb) = eval(a, b);
-        let r = x - xm;
-        let (g1, g2) = (r.dot(&ta), r.dot(&tb));
-        let (m11, m12, m22) = (ta.dot(&ta), ta.dot(&tb), tb.dot(&tb));
-        let det = m11 * m22 - m12 * m12;
-        if !(det > 0.0) {
-            break;
-        }
-        let da = (m22 * g1 - m12 * g2) / det;
-        let db = (m11 * g2 - m12 * g1) / det;
-        let (a0, b0) = (a, b);
-        a = (a + da).max(0.0);
-        b = (b + db).max(0.0);
-        if a + b > 1.0 {
-            let s = a + b;
-            a /= s;
-            b /= s;
-        }
-        if (a - a0).abs() + (b - b0).abs() < 1e-12 {
-            break;
-        }
-    }
-    let (w, xm, ta, tb) = eval(a, b);
-    let n = unit(ta.cross(&tb));
-    (xm.into(), n.into(), w.to_vec())
+    let p: Vec<Vec3> = face.nodes().iter().map(|&n| Vec3::from(pos(n))).collect();
+    (face.face_type().project)(&p, Vec3::from(x))
 }
 
 /// A uniform grid over the master faces' bounding boxes (inflated by the detection
@@ -615,12 +509,7 @@ pub fn frame_from_normal(n: [f64; 3]) -> [[f64; 3]; 3] {
 
 /// `a` scaled to unit length; e_y for the zero vector.
 pub(super) fn unit(a: Vec3) -> Vec3 {
-    let n = a.norm();
-    if n > 0.0 {
-        a / n
-    } else {
-        Vec3::y()
-    }
+    crate::element::face::unit(a)
 }
 
 #[cfg(test)]
@@ -722,7 +611,7 @@ mod tests {
             [0.1, 0.9, 0.0],
         ];
         let pos = |i: usize| nodes[i];
-        let face = Face::Quad([0, 1, 2, 3]);
+        let face = Face::quad([0, 1, 2, 3]);
         let x = [0.55, 0.4, 0.6];
         let (xm, n, w) = project_on_face(&face, &pos, x);
         // The weights are partition of unity and reproduce the projected point.
@@ -752,7 +641,7 @@ mod tests {
             [4.0, 0.0, 0.0],
             [4.0, 0.0, 3.0],
         ];
-        let faces = vec![Face::Quad([0, 1, 2, 3]), Face::Quad([1, 4, 5, 2])];
+        let faces = vec![Face::quad([0, 1, 2, 3]), Face::quad([1, 4, 5, 2])];
         let nodes = vec![0, 1, 2, 3, 4, 5];
         let a = tributary_areas(&faces, &coords, &nodes);
         assert!((a.iter().sum::<f64>() - 12.0).abs() < 1e-12);

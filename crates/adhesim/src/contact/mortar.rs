@@ -30,7 +30,7 @@
 use super::detect::Master;
 use super::detect::{frame_from_normal, unit, ContactPair, ContactPoint, Discretisation, FaceGrid};
 use super::polygon::{clip, counter_clockwise, polygon_quadrature, shape_at, Point2};
-use crate::element::{tri6_shape, TRI6_NODE_XI};
+use crate::element::FaceType;
 use crate::mesh::Face;
 use crate::Vec3;
 use std::collections::{BTreeMap, HashSet};
@@ -203,37 +203,6 @@ impl NodeIntegrals {
     }
 }
 
-/// How a point of a flat piece of a face gives the face's shape functions.
-#[derive(Clone, Copy, Debug)]
-enum PieceShape {
-    /// The piece is the whole (linear) face: its own weights are the shape functions.
-    Linear,
-    /// A sub-triangle of a six-node triangle: the natural coordinates of its corners.
-    Tri6([[f64; 2]; 3]),
-}
-
-impl PieceShape {
-    /// The shape of `piece` (positions in the node list of `face`).
-    fn of(face: &Face, piece: &[usize]) -> Self {
-        match face {
-            Face::Tri6(_) => PieceShape::Tri6(std::array::from_fn(|c| TRI6_NODE_XI[piece[c]])),
-            Face::Quad(_) | Face::Tri(_) => PieceShape::Linear,
-        }
-    }
-
-    /// The face's shape functions (one per node of the face) at the point of the piece where
-    /// the piece's own linear or bilinear weights are `w`.
-    fn face_shape(&self, w: Vec<f64>) -> Vec<f64> {
-        match self {
-            PieceShape::Linear => w,
-            PieceShape::Tri6(xi) => {
-                let at = |k: usize| w[0] * xi[0][k] + w[1] * xi[1][k] + w[2] * xi[2][k];
-                tri6_shape(at(0), at(1)).0.to_vec()
-            }
-        }
-    }
-}
-
 /// A flat piece of a slave face ([`Face::flat_pieces`]: the face itself when it is linear)
 /// laid on its plane. The contact pressure is interpolated on it linearly (bilinearly on a
 /// quadrilateral) from the piece's corners, each corner standing for its node: with linear
@@ -247,8 +216,9 @@ struct SlavePiece {
     nodes: Vec<usize>,
     /// The piece's corners, as positions in `nodes`.
     piece: &'static [usize],
-    /// How the piece's weights give the face's shape functions.
-    shape: PieceShape,
+    /// The face's type: how the piece's weights give the face's shape functions
+    /// ([`FaceType::shape_on_piece`]).
+    face_type: &'static FaceType,
     /// Centre [m] and unit outward normal of its plane, with two in-plane axes.
     centre: Vec3,
     normal: Vec3,
@@ -285,7 +255,7 @@ impl SlavePiece {
             .map(|p| [(p - centre).dot(&axes[0]), (p - centre).dot(&axes[1])])
             .collect();
         SlavePiece {
-            shape: PieceShape::of(face, piece),
+            face_type: face.face_type(),
             locals,
             nodes,
             piece,
@@ -332,15 +302,15 @@ impl SlavePiece {
                 let Some(master) = self.facing(&faces[fi], piece, pos, detection) else {
                     continue;
                 };
-                let master_shape = PieceShape::of(&faces[fi], piece);
+                let master_type = faces[fi].face_type();
                 let segment = clip(&slave_polygon, &counter_clockwise(master.clone()));
                 if segment.is_empty() {
                     continue;
                 }
                 for (p, w) in polygon_quadrature(&segment) {
                     let phi = shape_at(&self.corners, p);
-                    let ns = self.shape.face_shape(phi.clone());
-                    let nm = master_shape.face_shape(shape_at(&master, p));
+                    let ns = self.face_type.shape_on_piece(self.piece, phi.clone());
+                    let nm = master_type.shape_on_piece(piece, shape_at(&master, p));
                     for (c, &at) in self.piece.iter().enumerate() {
                         let node = &mut integrals[self.locals[at]];
                         node.covered += w * phi[c];
@@ -504,7 +474,7 @@ mod tests {
         let (mbase, mid) = grid(m[0], m[1], 0.0, &mut coords);
         let master: Vec<Face> = (0..m[1])
             .flat_map(|j| (0..m[0]).map(move |i| (i, j)))
-            .map(|(i, j)| Face::Quad([mid(i, j), mid(i + 1, j), mid(i + 1, j + 1), mid(i, j + 1)]))
+            .map(|(i, j)| Face::quad([mid(i, j), mid(i + 1, j), mid(i + 1, j + 1), mid(i, j + 1)]))
             .collect();
         let _ = mbase;
         let (sbase, sid) = grid(n[0], n[1], gap, &mut coords);
@@ -523,7 +493,7 @@ mod tests {
             master: Master::Faces(master),
             law: InterfaceLaw::rcc(0.0, None, None),
             detection_distance: 0.1,
-            slave_faces: slave_quads.iter().map(|&q| Face::Quad(q)).collect(),
+            slave_faces: slave_quads.iter().map(|&q| Face::quad(q)).collect(),
             slave_quads,
             thickness_twins: Vec::new(),
             discretisation: Default::default(),

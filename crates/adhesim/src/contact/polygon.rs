@@ -118,15 +118,8 @@ pub fn shape_at(corners: &[Point2], p: Point2) -> Vec<f64> {
     }
 }
 
-/// Bilinear shape functions of a quadrilateral at (ξ, η) ∈ [−1, 1]².
-pub fn quad_shape(xi: f64, eta: f64) -> [f64; 4] {
-    [
-        0.25 * (1.0 - xi) * (1.0 - eta),
-        0.25 * (1.0 + xi) * (1.0 - eta),
-        0.25 * (1.0 + xi) * (1.0 + eta),
-        0.25 * (1.0 - xi) * (1.0 + eta),
-    ]
-}
+/// Bilinear shape functions of a quadrilateral at (ξ, η) ∈ [−1, 1]² (the quad4 face's).
+pub use crate::element::quad4_shape as quad_shape;
 
 /// (ξ, η) of `p` in the bilinear map of the quadrilateral `c`, by Newton's method from the
 /// centre (exact in one step for a parallelogram).

@@ -5,7 +5,98 @@
 
 use crate::{Mat3, Vec3};
 
+use super::face::{square_quadrature, unit, FaceProjection, FaceType, LocalFace};
 use super::{gauss_point, DegenerateElement, Element, ElementType, GaussPoint, Stabilisation};
+
+/// The bilinear quadrilateral face of the hex8: corners counter-clockwise seen from outside,
+/// natural coordinates (ξ, η) ∈ [−1, 1]², drawn and integrated as itself.
+pub static QUAD4: FaceType = FaceType {
+    name: "quad4",
+    debug_name: "Quad",
+    nodes: 4,
+    corners: 4,
+    natural_nodes: &[[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]],
+    flat_pieces: &[&[0, 1, 2, 3]],
+    shape: |[xi, eta]| {
+        let (n, dn) = quad4_shape_and_derivatives(xi, eta);
+        (n.to_vec(), dn.to_vec())
+    },
+    quadrature: || square_quadrature(2),
+    vtk_type: 9,
+    gmsh_type: 3,
+    is_quadratic: false,
+    project: project_on_quad4,
+};
+
+/// A hex8 face with local nodes `nodes`.
+const fn quad4(nodes: &'static [usize]) -> LocalFace {
+    LocalFace {
+        face_type: &QUAD4,
+        nodes,
+    }
+}
+
+/// Bilinear shape functions of a quadrilateral at (ξ, η) ∈ [−1, 1]².
+pub fn quad4_shape(xi: f64, eta: f64) -> [f64; 4] {
+    [
+        0.25 * (1.0 - xi) * (1.0 - eta),
+        0.25 * (1.0 + xi) * (1.0 - eta),
+        0.25 * (1.0 + xi) * (1.0 + eta),
+        0.25 * (1.0 - xi) * (1.0 + eta),
+    ]
+}
+
+/// [`quad4_shape`] and the derivatives (∂N_a/∂ξ, ∂N_a/∂η).
+fn quad4_shape_and_derivatives(xi: f64, eta: f64) -> ([f64; 4], [[f64; 2]; 4]) {
+    let da = [
+        -0.25 * (1.0 - eta),
+        0.25 * (1.0 - eta),
+        0.25 * (1.0 + eta),
+        -0.25 * (1.0 + eta),
+    ];
+    let db = [
+        -0.25 * (1.0 - xi),
+        -0.25 * (1.0 + xi),
+        0.25 * (1.0 + xi),
+        0.25 * (1.0 - xi),
+    ];
+    (
+        quad4_shape(xi, eta),
+        std::array::from_fn(|a| [da[a], db[a]]),
+    )
+}
+
+/// Closest-point projection of `x` on the bilinear quadrilateral with corners `p` [m]: Newton
+/// (Gauss-Newton on ‖x − x(ξ,η)‖²) from the centre, each step clamped to the face.
+fn project_on_quad4(p: &[Vec3], x: Vec3) -> FaceProjection {
+    let (mut a, mut b) = (0.0f64, 0.0f64);
+    let eval = |a: f64, b: f64| {
+        let (w, d) = quad4_shape_and_derivatives(a, b);
+        let comb =
+            |c: [f64; 4]| -> Vec3 { Vec3::from_fn(|k, _| (0..4).map(|i| c[i] * p[i][k]).sum()) };
+        (w, comb(w), comb(d.map(|d| d[0])), comb(d.map(|d| d[1])))
+    };
+    for _ in 0..20 {
+        let (_, xm, ta, tb) = eval(a, b);
+        let r = x - xm;
+        let (g1, g2) = (r.dot(&ta), r.dot(&tb));
+        let (m11, m12, m22) = (ta.dot(&ta), ta.dot(&tb), tb.dot(&tb));
+        let det = m11 * m22 - m12 * m12;
+        if !(det > 0.0) {
+            break;
+        }
+        let da = (m22 * g1 - m12 * g2) / det;
+        let db = (m11 * g2 - m12 * g1) / det;
+        a = (a + da).clamp(-1.0, 1.0);
+        b = (b + db).clamp(-1.0, 1.0);
+        if da.abs() + db.abs() < 1e-12 {
+            break;
+        }
+    }
+    let (w, xm, ta, tb) = eval(a, b);
+    let n = unit(ta.cross(&tb));
+    (xm.into(), n.into(), w.to_vec())
+}
 
 /// The hex8 row of the element-type table.
 pub static HEX8: ElementType = ElementType {
@@ -16,12 +107,12 @@ pub static HEX8: ElementType = ElementType {
     gauss_rule: super::gauss_rule_of::<Hex8, 8, 8>,
     shape: super::shape_of::<Hex8, 8, 8>,
     faces: &[
-        &[0, 3, 2, 1], // ζ = −1
-        &[4, 5, 6, 7], // ζ = +1
-        &[0, 1, 5, 4], // η = −1
-        &[2, 3, 7, 6], // η = +1
-        &[0, 4, 7, 3], // ξ = −1
-        &[1, 2, 6, 5], // ξ = +1
+        quad4(&[0, 3, 2, 1]), // ζ = −1
+        quad4(&[4, 5, 6, 7]), // ζ = +1
+        quad4(&[0, 1, 5, 4]), // η = −1
+        quad4(&[2, 3, 7, 6]), // η = +1
+        quad4(&[0, 4, 7, 3]), // ξ = −1
+        quad4(&[1, 2, 6, 5]), // ξ = +1
     ],
     corner_frames: &[
         [0, 1, 3, 4],

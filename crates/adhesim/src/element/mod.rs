@@ -11,21 +11,32 @@
 //!   and the assembly loops are compiled for each type (no dynamic dispatch per element or
 //!   Gauss point).
 //!
-//! The types are trilinear hex8 (2×2×2 Gauss, `hex8.rs`), linear tet4 (1 point, `tet4.rs`)
-//! and quadratic tet10 (4 points, `tet10.rs`).
+//! The types are trilinear hex8 (2×2×2 Gauss, `hex8.rs`), linear tet4 (1 point, `tet4.rs`),
+//! quadratic tet10 (4 points, `tet10.rs`) and quadratic (serendipity) hex20 (3×3×3 points,
+//! `hex20.rs`). Their faces are described by face types (`face.rs`).
 //! Reference-configuration data (shape-function gradients, weights) are computed once; the
 //! kernels turn nodal displacements into internal force, consistent tangent (material +
 //! geometric) and strain energy.
 
+pub mod face;
+pub(crate) mod hex20;
 pub(crate) mod hex8;
 pub(crate) mod tet10;
 pub(crate) mod tet4;
 
-pub use hex8::{
-    hex8_centre, hex8_gauss_points, hex8_geometry, hex8_shape, Hex8, HEX8, HEX_NODE_XI,
+pub use face::{FaceType, LocalFace};
+pub use hex20::{
+    hex20_geometry, hex20_shape, quad8_shape, Hex20, HEX20, HEX20_EDGES, HEX20_NODE_XI, QUAD8,
+    QUAD8_NODE_XI,
 };
-pub use tet10::{tet10_geometry, tet10_shape, tri6_shape, Tet10, TET10, TET10_EDGES, TRI6_NODE_XI};
-pub use tet4::{tet4_geometry, tet4_shape, Tet4, TET4};
+pub use hex8::{
+    hex8_centre, hex8_gauss_points, hex8_geometry, hex8_shape, quad4_shape, Hex8, HEX8,
+    HEX_NODE_XI, QUAD4,
+};
+pub use tet10::{
+    tet10_geometry, tet10_shape, tri6_shape, Tet10, TET10, TET10_EDGES, TRI6, TRI6_NODE_XI,
+};
+pub use tet4::{tet4_geometry, tet4_shape, Tet4, TET4, TRI3};
 
 use crate::material::Hyperelastic;
 use crate::{Mat3, Vec3};
@@ -55,6 +66,7 @@ element_types! {
     Hex8, 8, 8, HEX8;
     Tet4, 4, 1, TET4;
     Tet10, 10, 4, TET10;
+    Hex20, 20, 27, HEX20;
 }
 
 /// What is done with each element type's Rust type ([`visit_element_types`]).
@@ -79,10 +91,10 @@ pub struct ElementType {
     /// Shape functions N_a and natural derivatives ∂N_a/∂ξ at ξ, as [`Element::shape`]
     /// gives them.
     pub shape: fn(xi: [f64; 3]) -> ShapeValues,
-    /// Local node indices of each face (a quadrilateral, a triangle, or a six-node triangle:
-    /// its corners, then its mid-side nodes), corners counter-clockwise seen from outside the
-    /// cell: boundary extraction and face sets use them.
-    pub faces: &'static [&'static [usize]],
+    /// Each face: its face type and local node indices (its corners counter-clockwise seen
+    /// from outside the cell, then its mid-side nodes): boundary extraction and face sets use
+    /// them.
+    pub faces: &'static [LocalFace],
     /// Corners for the scaled-Jacobian quality measure ([`crate::mesh::quality`]): each the
     /// corner node and its three neighbours along the natural axes, ordered so that the edge
     /// vectors form a right-handed frame in a valid cell.
@@ -139,7 +151,7 @@ impl ElementType {
 
     /// Whether the type is of second order (its faces have mid-side nodes).
     pub fn is_quadratic(&self) -> bool {
-        self.faces.iter().any(|f| f.len() > 4)
+        self.faces.iter().any(|f| f.face_type.is_quadratic)
     }
 
     /// The type called `name`, if adhesim has it.
@@ -551,7 +563,7 @@ mod table_tests {
             let x = t.natural_nodes;
             let mut volume = 0.0;
             for f in t.faces {
-                let f = crate::mesh::corners_of(f);
+                let f = f.corners();
                 for k in 1..f.len() - 1 {
                     let (p, q, r) = (x[f[0]], x[f[k]], x[f[k + 1]]);
                     volume += Vec3::from(p).dot(&sub(q, p).cross(&sub(r, p))) / 6.0;
@@ -580,7 +592,7 @@ mod table_tests {
             let c = c.map(|v| v / t.nodes as f64);
             let mut edges = std::collections::HashMap::new();
             for f in t.faces {
-                let f = crate::mesh::corners_of(f);
+                let f = f.corners();
                 let normal = sub(x[f[1]], x[f[0]]).cross(&sub(x[f[2]], x[f[0]]));
                 assert!(normal.dot(&sub(x[f[0]], c)) > 0.0, "{}: face {f:?}", t.name);
                 for k in 0..f.len() {

@@ -10,7 +10,48 @@
 //! element exactly in small strain (the products of the linear shape-function gradients), as
 //! the usual C3D10 does. The mass needs degree 4 and has its own closed form.
 
+use super::face::{
+    gauss_newton_projection, onto_triangle, triangle_quadrature, FaceProjection, FaceType,
+    LocalFace,
+};
 use super::{DegenerateElement, Element, ElementType, GaussPoint, Stabilisation};
+use crate::Vec3;
+
+/// The six-node triangular face of the tet10: corners counter-clockwise seen from outside,
+/// then the mid-side nodes of the edges 0-1, 1-2 and 2-0. It is drawn and integrated on its
+/// four sub-triangles (corner, mid, mid at each corner, and the middle one), whose hat
+/// functions are positive where the quadratic corner functions integrate to zero.
+pub static TRI6: FaceType = FaceType {
+    name: "tri6",
+    debug_name: "Tri6",
+    nodes: 6,
+    corners: 3,
+    natural_nodes: &TRI6_NODE_XI,
+    flat_pieces: &[&[0, 3, 5], &[3, 1, 4], &[5, 4, 2], &[3, 4, 5]],
+    shape: |[xi, eta]| {
+        let (n, dn) = tri6_shape(xi, eta);
+        (n.to_vec(), dn.to_vec())
+    },
+    quadrature: triangle_quadrature,
+    vtk_type: 22,
+    gmsh_type: 9,
+    is_quadratic: true,
+    project: project_on_tri6,
+};
+
+/// A tet10 face with local nodes `nodes`.
+const fn tri6(nodes: &'static [usize]) -> LocalFace {
+    LocalFace {
+        face_type: &TRI6,
+        nodes,
+    }
+}
+
+/// Closest-point projection of `x` on a six-node triangle with nodes `p` [m] by Gauss-Newton
+/// in its natural coordinates from the centroid, kept in the triangle.
+fn project_on_tri6(p: &[Vec3], x: Vec3) -> FaceProjection {
+    gauss_newton_projection(p, x, TRI6.shape, [1.0 / 3.0, 1.0 / 3.0], onto_triangle)
+}
 
 /// The edges of the mid-side nodes 4..9, by their end corners.
 pub const TET10_EDGES: [[usize; 2]; 6] = [[0, 1], [1, 2], [0, 2], [0, 3], [1, 3], [2, 3]];
@@ -36,10 +77,10 @@ pub static TET10: ElementType = ElementType {
     shape: super::shape_of::<Tet10, 10, 4>,
     // The tet4's faces, each followed by the mid-side nodes of its edges in order.
     faces: &[
-        &[0, 2, 1, 6, 5, 4],
-        &[0, 1, 3, 4, 8, 7],
-        &[1, 2, 3, 5, 9, 8],
-        &[0, 3, 2, 7, 9, 6],
+        tri6(&[0, 2, 1, 6, 5, 4]),
+        tri6(&[0, 1, 3, 4, 8, 7]),
+        tri6(&[1, 2, 3, 5, 9, 8]),
+        tri6(&[0, 3, 2, 7, 9, 6]),
     ],
     corner_frames: &[[0, 1, 2, 3]],
     inverted_inside: |x| {

@@ -2,7 +2,63 @@
 //!
 //! Nodes in VTK order, (x1−x0)·((x2−x0)×(x3−x0)) > 0.
 
+use super::face::{triangle_quadrature, unit, FaceProjection, FaceType, LocalFace};
 use super::{DegenerateElement, Element, ElementType, GaussPoint, Stabilisation};
+use crate::Vec3;
+
+/// The linear triangular face of the tet4: corners counter-clockwise seen from outside,
+/// natural coordinates (ξ, η) on the unit triangle, drawn and integrated as itself.
+pub static TRI3: FaceType = FaceType {
+    name: "tri3",
+    debug_name: "Tri",
+    nodes: 3,
+    corners: 3,
+    natural_nodes: &[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+    flat_pieces: &[&[0, 1, 2]],
+    shape: |[xi, eta]| {
+        (
+            vec![1.0 - xi - eta, xi, eta],
+            vec![[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]],
+        )
+    },
+    quadrature: triangle_quadrature,
+    vtk_type: 5,
+    gmsh_type: 2,
+    is_quadratic: false,
+    project: project_on_tri3,
+};
+
+/// A tet4 face with local nodes `nodes`.
+const fn tri3(nodes: &'static [usize]) -> LocalFace {
+    LocalFace {
+        face_type: &TRI3,
+        nodes,
+    }
+}
+
+/// Closest-point projection of `x` on the triangle with corners `p` [m], in closed form
+/// (the plane's barycentric coordinates moved onto the triangle).
+fn project_on_tri3(p: &[Vec3], x: Vec3) -> FaceProjection {
+    let (p0, p1, p2) = (p[0], p[1], p[2]);
+    let (e1, e2) = (p1 - p0, p2 - p0);
+    let n: [f64; 3] = unit(e1.cross(&e2)).into();
+    let r = x - p0;
+    let (m11, m12, m22) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
+    let (g1, g2) = (r.dot(&e1), r.dot(&e2));
+    let det = m11 * m22 - m12 * m12;
+    let mut a = (m22 * g1 - m12 * g2) / det;
+    let mut b = (m11 * g2 - m12 * g1) / det;
+    a = a.max(0.0);
+    b = b.max(0.0);
+    let s = a + b;
+    if s > 1.0 {
+        a /= s;
+        b /= s;
+    }
+    let w = vec![1.0 - a - b, a, b];
+    let xm = std::array::from_fn(|k| w[0] * p[0][k] + w[1] * p[1][k] + w[2] * p[2][k]);
+    (xm, n, w)
+}
 
 /// The tet4 row of the element-type table.
 pub static TET4: ElementType = ElementType {
@@ -17,7 +73,12 @@ pub static TET4: ElementType = ElementType {
     gauss_points: 1,
     gauss_rule: super::gauss_rule_of::<Tet4, 4, 1>,
     shape: super::shape_of::<Tet4, 4, 1>,
-    faces: &[&[0, 2, 1], &[0, 1, 3], &[1, 2, 3], &[0, 3, 2]],
+    faces: &[
+        tri3(&[0, 2, 1]),
+        tri3(&[0, 1, 3]),
+        tri3(&[1, 2, 3]),
+        tri3(&[0, 3, 2]),
+    ],
     corner_frames: &[[0, 1, 2, 3]],
     inverted_inside: |_| false,
     vtk_type: 10,

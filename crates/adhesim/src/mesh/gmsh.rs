@@ -16,13 +16,15 @@
 //!    Groups without a name are called `physical_<tag>`.
 //!
 //! Element types: the volume types of the element-type table
-//! ([`crate::element::ELEMENT_TYPES`], found by their Gmsh type number: hex8 (Gmsh type 5)
-//! and tet4 (4)) become cells; quad4 (3) and tri3 (2) are faces; points (15) and lines (1, 8,
-//! 26, 27, 28) only feed node sets. Gmsh's node orders of these types are adhesim's (VTK)
-//! orders, so cells are taken as they are. Other volume or surface elements are rejected.
+//! ([`crate::element::ELEMENT_TYPES`], found by their Gmsh type number: hex8 (Gmsh type 5),
+//! tet4 (4), tet10 (11) and hex20 (17)) become cells, their nodes taken in the order of the
+//! row's `gmsh_nodes` (Gmsh's order is adhesim's (VTK) order for hex8 and tet4; it differs
+//! in the mid-edge nodes of tet10 and hex20); quad4 (3), tri3 (2), tri6 (9) and quad8 (16)
+//! are faces; points (15) and lines (1, 8, 26, 27, 28) only feed node sets. Other volume or
+//! surface elements are rejected, and so is a file mixing first- and second-order volumes.
 
 use super::{Face, Mesh};
-use crate::element::{ElementType, ELEMENT_TYPES};
+use crate::element::{ElementType, FaceType, ELEMENT_TYPES};
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -64,16 +66,16 @@ impl std::error::Error for GmshError {}
 /// Dimension and tag of a physical group.
 pub type PhysicalKey = (i32, i32);
 
-/// One element of the file: its Gmsh tag, the geometric entity holding it and its nodes
-/// (indices into [`MshFile::nodes`]).
+/// One surface element of the file: its Gmsh tag, the geometric surface holding it and its
+/// nodes (indices into [`MshFile::nodes`]).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Element<const N: usize> {
+pub struct SurfaceElement {
     /// Gmsh element tag.
     pub tag: u64,
-    /// Tag of the geometric entity (of the element's dimension) that holds it.
+    /// Tag of the geometric surface that holds it.
     pub entity: i32,
-    /// Node indices into [`MshFile::nodes`].
-    pub nodes: [usize; N],
+    /// Node indices into [`MshFile::nodes`], in the face type's order.
+    pub nodes: Vec<usize>,
 }
 
 /// The volume elements of one type in file order: Gmsh tag, entity and nodes of each.
@@ -138,6 +140,42 @@ impl MshFile {
     }
 }
 
+/// The surface elements of one face type in file order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SurfaceElements {
+    /// The face type.
+    pub face_type: &'static FaceType,
+    /// The elements, in file order.
+    pub elements: Vec<SurfaceElement>,
+}
+
+impl MshFile {
+    /// The block of surface elements of `face_type`, created (in face-type order) when
+    /// missing.
+    fn surface_block_mut(&mut self, face_type: &'static FaceType) -> &mut SurfaceElements {
+        let order = |t: &FaceType| FaceType::all().iter().position(|f| *f == t);
+        let i = match self.surfaces.iter().position(|b| b.face_type == face_type) {
+            Some(i) => i,
+            None => {
+                let at = self
+                    .surfaces
+                    .iter()
+                    .position(|b| order(b.face_type) > order(face_type))
+                    .unwrap_or(self.surfaces.len());
+                self.surfaces.insert(
+                    at,
+                    SurfaceElements {
+                        face_type,
+                        elements: Vec::new(),
+                    },
+                );
+                at
+            }
+        };
+        &mut self.surfaces[i]
+    }
+}
+
 /// The content of an MSH 4.1 file that adhesim uses.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MshFile {
@@ -150,12 +188,10 @@ pub struct MshFile {
     /// Volume elements, one block per element type in the order of
     /// [`crate::element::ELEMENT_TYPES`] (no empty blocks).
     pub volumes: Vec<VolumeElements>,
-    /// Quad4 elements.
-    pub quads: Vec<Element<4>>,
-    /// Tri3 elements.
-    pub tris: Vec<Element<3>>,
-    /// Tri6 elements (faces of tet10 meshes).
-    pub tri6s: Vec<Element<6>>,
+    /// Surface elements of the face types adhesim has ([`FaceType::all`]), one block per
+    /// face type in that order (no empty blocks), nodes in Gmsh's order, which is the face
+    /// type's.
+    pub surfaces: Vec<SurfaceElements>,
     /// Point (dimension 0) and line (dimension 1) elements: dimension, entity, nodes.
     pub low_dim: Vec<(i32, i32, Vec<usize>)>,
     /// Physical group names by (dimension, tag); unnamed groups are `physical_<tag>`.
@@ -363,6 +399,22 @@ fn volume_type_names(sep: &str) -> String {
         .map(|t| t.name)
         .collect::<Vec<_>>()
         .join(sep)
+}
+
+/// The names of the face types adhesim reads, the last two joined by `last` (with their Gmsh
+/// type numbers when `numbers`).
+fn face_type_names(last: &str, numbers: bool) -> String {
+    let names: Vec<String> = FaceType::all()
+        .iter()
+        .map(|t| match numbers {
+            true => format!("{} ({})", t.name, t.gmsh_type),
+            false => t.name.to_string(),
+        })
+        .collect();
+    match names.split_last() {
+        Some((end, rest)) if !rest.is_empty() => format!("{}{last}{end}", rest.join(", ")),
+        _ => names.join(""),
+    }
 }
 
 fn element_type(t: i32) -> Option<(&'static str, usize, i32)> {
@@ -822,8 +874,13 @@ impl Parser<'_> {
                         }
                     })
                     .collect();
-                return Err(self.err_at(at_type,
-                    format!("element type {etype} is not known: adhesim reads {} volumes, quad4 (3), tri3 (2) and tri6 (9) faces", volumes.join(", ")),
+                return Err(self.err_at(
+                    at_type,
+                    format!(
+                        "element type {etype} is not known: adhesim reads {} volumes, {} faces",
+                        volumes.join(", "),
+                        face_type_names(" and ", true)
+                    ),
                 ));
             };
             if edim != dim {
@@ -832,7 +889,8 @@ impl Parser<'_> {
                 ));
             }
             let volume = ElementType::from_gmsh(etype);
-            let supported = matches!(etype, 2 | 3 | 9) || volume.is_some() || dim <= 1;
+            let surface = FaceType::from_gmsh(etype);
+            let supported = volume.is_some() || surface.is_some() || dim <= 1;
             if !supported {
                 let fix = if matches!(etype, 6 | 7 | 13 | 14 | 18 | 19) {
                     format!(
@@ -841,11 +899,11 @@ impl Parser<'_> {
                     )
                 } else if dim == 3 {
                     format!(
-                        "the volume elements adhesim reads are {}: remesh with first-order elements (Mesh.ElementOrder = 1), or with second-order tetrahedra (Mesh.ElementOrder = 2 on a tetrahedral mesh)",
+                        "the volume elements adhesim reads are {}: remesh with first-order elements (Mesh.ElementOrder = 1), or at second order with Mesh.ElementOrder = 2 and Mesh.SecondOrderIncomplete = 1 (tet10, or 20-node hexahedra without the face and centre nodes)",
                         volume_type_names(", ")
                     )
                 } else {
-                    "adhesim reads quad4, tri3 and tri6 surface elements: remesh with first-order elements (Mesh.ElementOrder = 1), or second-order tetrahedra, whose faces are tri6".to_string()
+                    format!("adhesim reads {} surface elements: remesh with first-order elements (Mesh.ElementOrder = 1), or at second order with Mesh.SecondOrderIncomplete = 1 (tet10 with tri6 faces, hex20 with quad8 faces)", face_type_names(" and ", false))
                 };
                 return Err(self.err_at(
                     at_type,
@@ -882,22 +940,16 @@ impl Parser<'_> {
                         .extend(element.gmsh_nodes.iter().map(|&g| nodes[g]));
                     continue;
                 }
+                if let Some(face_type) = surface {
+                    let block = msh.surface_block_mut(face_type);
+                    block.elements.push(SurfaceElement {
+                        tag,
+                        entity,
+                        nodes: nodes.clone(),
+                    });
+                    continue;
+                }
                 match etype {
-                    2 => msh.tris.push(Element {
-                        tag,
-                        entity,
-                        nodes: [nodes[0], nodes[1], nodes[2]],
-                    }),
-                    3 => msh.quads.push(Element {
-                        tag,
-                        entity,
-                        nodes: [nodes[0], nodes[1], nodes[2], nodes[3]],
-                    }),
-                    9 => msh.tri6s.push(Element {
-                        tag,
-                        entity,
-                        nodes: std::array::from_fn(|k| nodes[k]),
-                    }),
                     _ => {
                         // Points and lines: only their end nodes matter (node sets).
                         let used = if dim == 0 { 1 } else { 2 };
@@ -1099,11 +1151,9 @@ impl MshFile {
         let owners = mesh.cell_faces();
         let mut faces: BTreeMap<String, (Vec<Face>, Vec<usize>)> = BTreeMap::new();
         let surface = self
-            .quads
+            .surfaces
             .iter()
-            .map(|e| (e.tag, e.entity, &e.nodes[..]))
-            .chain(self.tris.iter().map(|e| (e.tag, e.entity, &e.nodes[..])))
-            .chain(self.tri6s.iter().map(|e| (e.tag, e.entity, &e.nodes[..])));
+            .flat_map(|b| b.elements.iter().map(|e| (e.tag, e.entity, &e.nodes[..])));
         for (tag, entity, nodes) in surface {
             if self.groups(2, entity).next().is_none()
                 || nodes.iter().any(|&i| new_id[i] == usize::MAX)
@@ -1326,9 +1376,10 @@ $EndElements
         let e = parse_str(&CUBE.replace("1 1 0\n0 1 0", "1 1 0\n0 nan 0")).unwrap_err();
         assert_eq!(e.location, Some(Location::Line(28)), "{e}");
         assert!(e.to_string().starts_with("cube.msh:28: "), "{e}");
-        let e = parse_str(&CUBE.replace("3 1 5 1", "3 1 17 1")).unwrap_err();
+        let e = parse_str(&CUBE.replace("3 1 5 1", "3 1 12 1")).unwrap_err();
         assert!(
-            e.message.contains("hex20 (Gmsh type 17) is not supported"),
+            e.message.contains("hex27 (Gmsh type 12) is not supported")
+                && e.message.contains("SecondOrderIncomplete"),
             "{e}"
         );
         let e = parse_str(&CUBE.replace("1 2 3 4 5 6 7 8\n", "1 2 3 4 5 6 7 9\n")).unwrap_err();
@@ -1339,6 +1390,21 @@ $EndElements
         for k in 0..CUBE.len() - 1 {
             assert!(parse_str(&CUBE[..k]).is_err(), "truncated at {k}");
         }
+    }
+
+    /// A hex8 and a hex20 in one file: refused, naming both types.
+    #[test]
+    fn mixed_orders_are_refused_naming_the_types() {
+        let mixed = CUBE.replace("2 2 1 2\n", "3 3 1 3\n").replace(
+            "$EndElements",
+            "3 1 17 1\n3 1 2 3 4 5 6 7 8 1 2 3 4 5 6 7 8 1 2 3 4\n$EndElements",
+        );
+        let e = parse_str(&mixed).unwrap_err();
+        assert!(
+            e.message.contains("mixes first- and second-order")
+                && e.message.contains("hex8 and hex20"),
+            "{e}"
+        );
     }
 
     #[test]

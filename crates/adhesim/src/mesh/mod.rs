@@ -1,7 +1,7 @@
 //! Meshes: nodes, cell blocks, named node and face sets. No physics here.
 //!
 //! The cells are kept in blocks, one per element type of [`crate::element::ELEMENT_TYPES`]
-//! in the table's order (hex8, then tet4), each a flat connectivity list. A cell's index in
+//! in the table's order (hex8, tet4, tet10, hex20), each a flat connectivity list. A cell's index in
 //! the mesh counts through the blocks in that order.
 //!
 //! Conventions
@@ -10,88 +10,121 @@
 //!   (−1,−1,−1), (1,−1,−1), (1,1,−1), (−1,1,−1), (−1,−1,1), (1,−1,1), (1,1,1), (−1,1,1)).
 //!   A valid hex has positive Jacobian determinant at all its Gauss points.
 //! - Tet4 cells use the VTK order; (x1−x0)·((x2−x0)×(x3−x0)) > 0.
+//! - Tet10 and hex20 cells use the VTK orders: the corners as for tet4 and hex8, then the
+//!   mid-edge nodes ([`crate::element::TET10_EDGES`], [`crate::element::HEX20_EDGES`]).
 //! - Boundary faces are listed counter-clockwise seen from outside the body, so that the
-//!   right-hand-rule normal points out of the body.
+//!   right-hand-rule normal points out of the body. A face is its face type (one of
+//!   [`crate::element::face`], named by the element type it bounds) and its nodes.
 
 use std::collections::BTreeMap;
 
-use crate::element::{ElementType, HEX8, TET10, TET4};
+use crate::element::face::MAX_FACE_NODES;
+use crate::element::{
+    ElementType, FaceType, LocalFace, HEX20, HEX20_EDGES, HEX8, QUAD4, QUAD8, TET10, TET10_EDGES,
+    TET4, TRI3, TRI6,
+};
 
 pub mod generate;
 pub mod gmsh;
 pub mod quality;
 
-/// A boundary face of a cell: a bilinear quadrilateral, a linear triangle or a quadratic
-/// triangle.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Face {
-    /// Quadrilateral face of a hex8, nodes counter-clockwise seen from outside.
-    Quad([usize; 4]),
-    /// Triangular face of a tet4, nodes counter-clockwise seen from outside.
-    Tri([usize; 3]),
-    /// Six-node triangular face of a tet10: corners counter-clockwise seen from outside, then
-    /// the mid-side nodes of edges 0-1, 1-2 and 2-0.
-    Tri6([usize; 6]),
+/// A boundary face of a cell: its face type (which comes from the cell's element type) and
+/// its node indices in that type's order (corners counter-clockwise seen from outside, then
+/// mid-side nodes).
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Face {
+    /// The face's type.
+    face_type: &'static FaceType,
+    /// Node indices; the first `face_type.nodes` are the face's, the rest 0.
+    nodes: [usize; MAX_FACE_NODES],
+}
+
+/// `Quad([0, 1, 2, 3])`: the face type's `debug_name` and the nodes, the form the checkpoint
+/// fingerprint of a problem hashes.
+impl std::fmt::Debug for Face {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_tuple(self.face_type.debug_name)
+            .field(&self.nodes())
+            .finish()
+    }
 }
 
 impl Face {
-    /// The face of `cell` (global node indices) with local nodes `local` (three, four or
-    /// six).
-    pub fn of_cell(cell: &[usize], local: &[usize]) -> Face {
-        match *local {
-            [a, b, c] => Face::Tri([cell[a], cell[b], cell[c]]),
-            [a, b, c, d] => Face::Quad([cell[a], cell[b], cell[c], cell[d]]),
-            [a, b, c, d, e, f] => {
-                Face::Tri6([cell[a], cell[b], cell[c], cell[d], cell[e], cell[f]])
-            }
-            _ => panic!(
-                "a cell face has three, four or six nodes, not {}",
-                local.len()
-            ),
+    /// The face of type `face_type` with nodes `nodes` (as many as the type has).
+    pub fn new(face_type: &'static FaceType, nodes: &[usize]) -> Face {
+        assert_eq!(
+            nodes.len(),
+            face_type.nodes,
+            "a {} face has {} nodes",
+            face_type.name,
+            face_type.nodes
+        );
+        let mut all = [0; MAX_FACE_NODES];
+        all[..nodes.len()].copy_from_slice(nodes);
+        Face {
+            face_type,
+            nodes: all,
         }
+    }
+
+    /// A bilinear quadrilateral (a hex8 face), nodes counter-clockwise seen from outside.
+    pub fn quad(nodes: [usize; 4]) -> Face {
+        Face::new(&QUAD4, &nodes)
+    }
+
+    /// A linear triangle (a tet4 face), nodes counter-clockwise seen from outside.
+    pub fn tri(nodes: [usize; 3]) -> Face {
+        Face::new(&TRI3, &nodes)
+    }
+
+    /// The face `local` of `cell` (global node indices).
+    pub fn of_cell(cell: &[usize], local: &LocalFace) -> Face {
+        let mut nodes = [0; MAX_FACE_NODES];
+        for (n, &a) in nodes.iter_mut().zip(local.nodes) {
+            *n = cell[a];
+        }
+        Face {
+            face_type: local.face_type,
+            nodes,
+        }
+    }
+
+    /// The face's type.
+    pub fn face_type(&self) -> &'static FaceType {
+        self.face_type
     }
 
     /// The face's node indices.
     pub fn nodes(&self) -> &[usize] {
-        match self {
-            Face::Quad(n) => n,
-            Face::Tri(n) => n,
-            Face::Tri6(n) => n,
+        &self.nodes[..self.face_type.nodes]
+    }
+
+    /// The same face with each node index `n` replaced by `map(n)`.
+    pub fn map_nodes(&self, map: impl Fn(usize) -> usize) -> Face {
+        let mut nodes = [0; MAX_FACE_NODES];
+        for (n, &m) in nodes.iter_mut().zip(self.nodes()) {
+            *n = map(m);
+        }
+        Face {
+            face_type: self.face_type,
+            nodes,
         }
     }
 
     /// The face's corner nodes, counter-clockwise seen from outside.
     pub fn corners(&self) -> &[usize] {
-        corners_of(self.nodes())
+        &self.nodes[..self.face_type.corners]
     }
 
-    /// The flat pieces the face is drawn and integrated on: itself when it is linear; a
-    /// six-node triangle's four sub-triangles (corner, mid, mid and the middle one), each
-    /// counter-clockwise. Entries are positions in [`Face::nodes`].
+    /// The flat pieces the face is drawn and integrated on ([`FaceType::flat_pieces`]):
+    /// itself when it is linear. Entries are positions in [`Face::nodes`].
     pub fn flat_pieces(&self) -> &'static [&'static [usize]] {
-        match self {
-            Face::Quad(_) => &[&[0, 1, 2, 3]],
-            Face::Tri(_) => &[&[0, 1, 2]],
-            Face::Tri6(_) => TRI6_PIECES,
-        }
+        self.face_type.flat_pieces
     }
 
     /// Whether the face is of second order (has mid-side nodes).
     pub fn is_quadratic(&self) -> bool {
-        matches!(self, Face::Tri6(_))
-    }
-}
-
-/// The four sub-triangles of a six-node triangle, as positions in its node list.
-pub const TRI6_PIECES: &[&[usize]] = &[&[0, 3, 5], &[3, 1, 4], &[5, 4, 2], &[3, 4, 5]];
-
-/// The corners of a face given by its nodes (three, four or six): the first three of a
-/// six-node triangle, all the nodes of a linear face.
-pub fn corners_of(nodes: &[usize]) -> &[usize] {
-    match nodes.len() {
-        6 => &nodes[..3],
-        8 | 9 => &nodes[..4],
-        _ => nodes,
+        self.face_type.is_quadratic
     }
 }
 
@@ -322,18 +355,18 @@ impl Mesh {
 }
 
 impl Mesh {
-    /// The same tetrahedral body with second-order tetrahedra: a node at the middle of every
-    /// edge (shared by the cells around it), each tet4 becoming a straight-sided tet10; face
-    /// sets become six-node triangles and node sets take the mid-side nodes of edges whose
-    /// ends are both in the set. Hexahedra are split first ([`Mesh::split_hexes_into_tets`]).
+    /// The same body with second-order cells: a node at the middle of every edge (shared by
+    /// the cells around it), each tet4 becoming a straight-sided tet10 and each hex8 a
+    /// straight-sided hex20; face sets become six-node triangles and eight-node
+    /// quadrilaterals, and node sets take the mid-side nodes of edges whose ends are both in
+    /// the set. (For tet10 from a hexahedral mesh, split it first:
+    /// [`Mesh::split_hexes_into_tets`].)
+    ///
+    /// # Panics
+    /// The mesh already holds second-order cells.
     pub fn with_mid_side_nodes(&self) -> Mesh {
-        let tets = if self.hexes().is_empty() {
-            self.clone()
-        } else {
-            self.split_hexes_into_tets()
-        };
         let mut out = Mesh {
-            nodes: tets.nodes.clone(),
+            nodes: self.nodes.clone(),
             ..Default::default()
         };
         let mut mid: std::collections::HashMap<(usize, usize), usize> =
@@ -346,17 +379,20 @@ impl Mesh {
                 nodes.len() - 1
             })
         };
-        let mut cells = Vec::with_capacity(tets.tets().len());
-        for t in tets.tets() {
-            let mut c = [0usize; 10];
-            c[..4].copy_from_slice(t);
-            for (m, [i, j]) in crate::element::tet10::TET10_EDGES.iter().enumerate() {
-                c[4 + m] = mid_of(t[*i], t[*j], &mut out.nodes);
+        for block in &self.blocks {
+            let (quadratic, edges) = second_order_of(block.element);
+            let mut cells =
+                Vec::with_capacity(block.connectivity.len() + block.len() * edges.len());
+            for t in block.cells() {
+                cells.extend_from_slice(t);
+                for [i, j] in edges {
+                    let m = mid_of(t[*i], t[*j], &mut out.nodes);
+                    cells.push(m);
+                }
             }
-            cells.push(c);
+            out.connectivity_mut(quadratic).extend(cells);
         }
-        out.add_cells(&TET10, cells);
-        for (name, ids) in &tets.node_sets {
+        for (name, ids) in &self.node_sets {
             let inside: std::collections::HashSet<usize> = ids.iter().copied().collect();
             let mut with_mids = ids.clone();
             with_mids.extend(
@@ -366,18 +402,33 @@ impl Mesh {
             );
             out.set_nodes(name, with_mids);
         }
-        for (name, faces) in &tets.face_sets {
+        for (name, faces) in &self.face_sets {
             let quadratic = faces
                 .iter()
                 .map(|f| {
-                    let n = f.nodes();
+                    let n = f.corners();
                     let m = |a: usize, b: usize| mid[&(n[a].min(n[b]), n[a].max(n[b]))];
-                    Face::Tri6([n[0], n[1], n[2], m(0, 1), m(1, 2), m(2, 0)])
+                    let mut with_mids = n.to_vec();
+                    with_mids.extend((0..n.len()).map(|k| m(k, (k + 1) % n.len())));
+                    let face_type = if n.len() == 3 { &TRI6 } else { &QUAD8 };
+                    Face::new(face_type, &with_mids)
                 })
                 .collect();
             out.face_sets.insert(name.clone(), quadratic);
         }
         out
+    }
+}
+
+/// The second-order type of the first-order `element` (tet10 of tet4, hex20 of hex8) and the
+/// corner pairs of its mid-edge nodes, in its node order.
+fn second_order_of(element: &ElementType) -> (&'static ElementType, &'static [[usize; 2]]) {
+    if *element == TET4 {
+        (&TET10, &TET10_EDGES)
+    } else if *element == HEX8 {
+        (&HEX20, &HEX20_EDGES)
+    } else {
+        panic!("{} cells have mid-side nodes already", element.name)
     }
 }
 
@@ -433,17 +484,16 @@ impl Mesh {
         for (name, faces) in &self.face_sets {
             let mut tris = Vec::new();
             for f in faces {
-                match f {
-                    Face::Tri(_) | Face::Tri6(_) => tris.push(*f),
-                    Face::Quad(q) => {
-                        for skip in 0..4 {
-                            let mut key: Vec<usize> =
-                                (0..4).filter(|&i| i != skip).map(|i| q[i]).collect();
-                            key.sort_unstable();
-                            if let Some(t) = boundary.get(&key) {
-                                tris.push(*t);
-                            }
-                        }
+                if *f.face_type() != QUAD4 {
+                    tris.push(*f);
+                    continue;
+                }
+                let q = f.nodes();
+                for skip in 0..4 {
+                    let mut key: Vec<usize> = (0..4).filter(|&i| i != skip).map(|i| q[i]).collect();
+                    key.sort_unstable();
+                    if let Some(t) = boundary.get(&key) {
+                        tris.push(*t);
                     }
                 }
             }
