@@ -711,3 +711,58 @@ fn two_body_hertz(discretisation: PairDiscretisation) -> f64 {
     );
     force
 }
+
+/// Accuracy against cost of the element types on one problem (docs/elements.md): the
+/// nearly incompressible Hertz indentation above (ν = 0.4999, rigid sphere, a/R = 0.01) on
+/// the graded octant with k cells across the core (h = 1.5 a / k), as F-bar hexahedra, as
+/// those hexahedra split into six linear tetrahedra (standard and averaged nodal pressure),
+/// and as the split with a node at the middle of every edge (tet10, constant pressure per
+/// element). Prints force error, contact radius, Newton iterations, unknowns and wall time
+/// of each run; the k values come from `HERTZ_TABLE_K` (default "2 4 6").
+#[test]
+#[ignore = "a measurement: cargo test --release -p adhesim --test hertz_sphere element_cost_table -- --ignored --nocapture"]
+fn element_cost_table() {
+    let nu = 0.4999;
+    let (material, f_hertz) = nearly_incompressible(nu);
+    let a = (R * D).sqrt();
+    let ks: Vec<usize> = std::env::var("HERTZ_TABLE_K")
+        .unwrap_or_else(|_| "2 4 6".into())
+        .split_whitespace()
+        .map(|k| k.parse().unwrap())
+        .collect();
+    for k in ks {
+        let c = 1.5 * a;
+        let hexes = graded_octant(c, k, 1.0 + 1.0 / k as f64, EXTENT * a);
+        let tets = hexes.split_hexes_into_tets();
+        let tet10 = hexes.with_mid_side_nodes();
+        let run = |mesh: &Mesh, element| {
+            indent_on(
+                mesh.clone(),
+                c / k as f64,
+                material.clone(),
+                element,
+                0.75 * D,
+                ContactSolver::Auto,
+            )
+        };
+        for (name, mesh, element) in [
+            ("hex8 F-bar", &hexes, Formulation::FBar),
+            ("tet4", &tets, Formulation::Standard),
+            ("tet4 anp", &tets, Formulation::AveragedNodalPressure),
+            ("tet10 constant pressure", &tet10, Formulation::FBar),
+        ] {
+            let r = run(mesh, element);
+            eprintln!(
+                "k = {k} (h = a/{:.2}), {name}: {} cells, {} unknowns, F {:+.2} % off Hertz, \
+                 contact radius {:.3} a, {} Newton iterations, {:.2} s",
+                k as f64 / 1.5,
+                mesh.blocks.iter().map(|b| b.len()).sum::<usize>(),
+                r.dofs,
+                100.0 * (r.force / f_hertz - 1.0),
+                r.radius / a,
+                r.newton,
+                r.seconds
+            );
+        }
+    }
+}
