@@ -766,3 +766,151 @@ fn element_cost_table() {
         }
     }
 }
+
+/// The quarter hemisphere of tests/data/hertz-hemisphere.geo (R = 5 mm, apex at the origin,
+/// flat top at y = R) from its Gmsh mesh `file` (second-order or the same lowered to first
+/// order), in metres.
+fn gmsh_hemisphere(file: &str) -> Mesh {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(file);
+    let mut mesh = adhesim::mesh::gmsh::read(&path)
+        .expect("the test's mesh")
+        .body(None)
+        .expect("one body")
+        .mesh;
+    for p in &mut mesh.nodes {
+        *p = p.map(|x| x * 1e-3);
+    }
+    mesh
+}
+
+/// Hertz between two soft bodies, a Gmsh sphere on a block: the quarter hemisphere of
+/// tests/data/hertz-hemisphere.geo (R = 5 mm, elements of a/3 at the apex) pressed by
+/// d = 2 µm (a = √(R d) = 0.1 mm, a/R = 0.02) into the graded quarter half-space of
+/// [`graded_octant`] (k = 3 cells across its core of 1.5 a, h = a/2, truncated at 1000 a),
+/// both nearly incompressible (uncoupled neo-Hookean, ν = 0.4999, G = 1 MPa), so
+/// E* = E/(2(1 − ν²)) from the two; mortar contact, the sphere's curved face the slave.
+/// Second-order: both bodies tet10 with one pressure per element; first-order: the
+/// hemisphere's mesh lowered to order 1 and the block's hexahedra split into tet4, both with
+/// the averaged nodal pressure. The hemisphere held at its top is stiffer than Hertz's
+/// half-space by about 1 % (tests/hertz_gmsh_tet10.rs); tolerance 2 % for tet10, and the
+/// first-order meshes must be further off.
+///
+/// Ignored (a measurement, 80-90 s): with the curved six-node faces as the mortar slave the
+/// one step is cut back to 1/16 and then every third step once more (the first-order meshes
+/// and a first-order sphere on the tet10 block take the one step in 5-6 Newton iterations).
+/// The first attempt fails in the semismooth contact solve at the first Newton iteration:
+/// it stalls after 3 steps with a zero contact residual and the out-of-balance force not
+/// removed; the Gauss-Seidel solve is cut back alike. Not yet understood;
+/// tests/hertz_gmsh_tet10.rs is the tet10 Hertz test that runs.
+#[test]
+#[ignore = "80-90 s: cargo test --release -p adhesim --test hertz_sphere gmsh -- --ignored --nocapture"]
+fn hertz_gmsh_tet10_sphere_on_a_tet10_block() {
+    let (r, d) = (5e-3f64, 2e-6f64);
+    let (material, _) = nearly_incompressible(0.4999);
+    let nu = 0.4999;
+    let e_star = 2.0 * G * (1.0 + nu) / (2.0 * (1.0 - nu * nu));
+    let f_hertz = 4.0 / 3.0 * e_star * r.sqrt() * d.powf(1.5);
+    let a = (r * d).sqrt();
+    let k = 3;
+    let hexes = graded_octant(1.5 * a, k, 1.0 + 1.0 / k as f64, EXTENT * a);
+    let mut errors = Vec::new();
+    for (name, lower, file, element) in [
+        (
+            "tet10",
+            hexes.with_mid_side_nodes(),
+            "hertz-hemisphere-tet10.msh",
+            Formulation::FBar,
+        ),
+        (
+            "tet4 anp",
+            hexes.split_hexes_into_tets(),
+            "hertz-hemisphere-tet4.msh",
+            Formulation::AveragedNodalPressure,
+        ),
+    ] {
+        let upper = gmsh_hemisphere(file);
+        let off = lower.num_nodes();
+        let shift = |ns: &[usize]| ns.iter().map(|n| n + off).collect::<Vec<_>>();
+        let slave_set = upper.node_sets["curved"].clone();
+        let slave_faces = &upper.face_sets["curved"];
+        let local = local_faces(slave_faces, &slave_set);
+        let slave_area = tributary_areas(slave_faces, &upper.nodes, &slave_set);
+        let body = |name: &str, mesh: &Mesh| Body {
+            name: name.into(),
+            mesh: mesh.clone(),
+            material: material.clone(),
+            density: 1000.0,
+            initial_velocity: [0.0; 3],
+            element,
+            plane_strain: false,
+        };
+        let mut push = fixed(shift(&upper.node_sets["top"]), [true, true, true]);
+        push.translation[1] = Table {
+            t: vec![0.0, 1.0],
+            v: vec![0.0, -d],
+        };
+        let problem = Problem {
+            name: "hertz-gmsh-two-bodies".into(),
+            bodies: vec![body("block", &lower), body("sphere", &upper)],
+            dirichlet: vec![
+                fixed(lower.node_sets["sym_x"].clone(), [true, false, false]),
+                fixed(lower.node_sets["sym_z"].clone(), [false, false, true]),
+                fixed(lower.node_sets["outer"].clone(), [true, true, true]),
+                fixed(shift(&upper.node_sets["sym_x"]), [true, false, false]),
+                fixed(shift(&upper.node_sets["sym_z"]), [false, false, true]),
+                push,
+            ],
+            loads: vec![],
+            gravity: Default::default(),
+            time: TimeSettings {
+                t_end: 1.0,
+                quasi_static: true,
+                dt: 1.0,
+                contact_solver: ContactSolver::Semismooth,
+                ..TimeSettings::default()
+            },
+            contacts: vec![ContactPair {
+                name: "hertz".into(),
+                slave_nodes: shift(&slave_set),
+                slave_area,
+                master: Master::Faces(lower.face_sets["top"].clone()),
+                law: InterfaceLaw::rcc(0.0, None, None),
+                // Candidates: initial gap r²/2R < 3 d, i.e. r < 2.4 a.
+                detection_distance: 3.0 * d,
+                slave_quads: flat_quads(&local),
+                slave_faces: local,
+                thickness_twins: vec![],
+                discretisation: PairDiscretisation::Mortar,
+            }],
+        };
+        let clock = Instant::now();
+        let mut s = Stepper::new(Arc::new(problem)).expect("valid meshes");
+        let (mut newton, mut cutbacks, mut steps) = (0, 0, 0);
+        while !s.finished() {
+            let rep = s.step().expect("the indentation converges");
+            newton += rep.newton_iterations;
+            cutbacks += rep.cutbacks;
+            steps += 1;
+        }
+        let force = 4.0 * s.contact[0].iter().map(|c| c.force[1]).sum::<f64>();
+        let err = force / f_hertz - 1.0;
+        eprintln!(
+            "Gmsh sphere on a block, {name}, mortar: F = {force:.5e} N, {:+.2} % off Hertz \
+             {f_hertz:.5e} N, {steps} steps, {cutbacks} cut-backs, {newton} Newton iterations \
+             in the steps kept, {} unknowns, {:.1} s",
+            100.0 * err,
+            s.disc.num_dofs(),
+            clock.elapsed().as_secs_f64()
+        );
+        errors.push(err);
+    }
+    assert!(errors[0].abs() < 0.02, "tet10 {:+.2} %", 100.0 * errors[0]);
+    assert!(
+        errors[1].abs() > errors[0].abs(),
+        "first order {:+.2} % against tet10 {:+.2} %",
+        100.0 * errors[1],
+        100.0 * errors[0]
+    );
+}
