@@ -711,3 +711,204 @@ fn two_body_hertz(discretisation: PairDiscretisation) -> f64 {
     );
     force
 }
+
+/// Accuracy against cost of the element types on one problem (docs/elements.md): the
+/// nearly incompressible Hertz indentation above (ν = 0.4999, rigid sphere, a/R = 0.01) on
+/// the graded octant with k cells across the core (h = 1.5 a / k), as F-bar hexahedra, as
+/// those hexahedra split into six linear tetrahedra (standard and averaged nodal pressure),
+/// and as the split with a node at the middle of every edge (tet10, constant pressure per
+/// element). Prints force error, contact radius, Newton iterations, unknowns and wall time
+/// of each run; the k values come from `HERTZ_TABLE_K` (default "2 4 6").
+#[test]
+#[ignore = "a measurement: cargo test --release -p adhesim --test hertz_sphere element_cost_table -- --ignored --nocapture"]
+fn element_cost_table() {
+    let nu = 0.4999;
+    let (material, f_hertz) = nearly_incompressible(nu);
+    let a = (R * D).sqrt();
+    let ks: Vec<usize> = std::env::var("HERTZ_TABLE_K")
+        .unwrap_or_else(|_| "2 4 6".into())
+        .split_whitespace()
+        .map(|k| k.parse().unwrap())
+        .collect();
+    for k in ks {
+        let c = 1.5 * a;
+        let hexes = graded_octant(c, k, 1.0 + 1.0 / k as f64, EXTENT * a);
+        let tets = hexes.split_hexes_into_tets();
+        let tet10 = hexes.with_mid_side_nodes();
+        let run = |mesh: &Mesh, element| {
+            indent_on(
+                mesh.clone(),
+                c / k as f64,
+                material.clone(),
+                element,
+                0.75 * D,
+                ContactSolver::Auto,
+            )
+        };
+        for (name, mesh, element) in [
+            ("hex8 F-bar", &hexes, Formulation::FBar),
+            ("tet4", &tets, Formulation::Standard),
+            ("tet4 anp", &tets, Formulation::AveragedNodalPressure),
+            ("tet10 constant pressure", &tet10, Formulation::FBar),
+        ] {
+            let r = run(mesh, element);
+            eprintln!(
+                "k = {k} (h = a/{:.2}), {name}: {} cells, {} unknowns, F {:+.2} % off Hertz, \
+                 contact radius {:.3} a, {} Newton iterations, {:.2} s",
+                k as f64 / 1.5,
+                mesh.blocks.iter().map(|b| b.len()).sum::<usize>(),
+                r.dofs,
+                100.0 * (r.force / f_hertz - 1.0),
+                r.radius / a,
+                r.newton,
+                r.seconds
+            );
+        }
+    }
+}
+
+/// The quarter hemisphere of tests/data/hertz-hemisphere.geo (R = 5 mm, apex at the origin,
+/// flat top at y = R) from its Gmsh mesh `file` (second-order or the same lowered to first
+/// order), in metres.
+fn gmsh_hemisphere(file: &str) -> Mesh {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(file);
+    let mut mesh = adhesim::mesh::gmsh::read(&path)
+        .expect("the test's mesh")
+        .body(None)
+        .expect("one body")
+        .mesh;
+    for p in &mut mesh.nodes {
+        *p = p.map(|x| x * 1e-3);
+    }
+    mesh
+}
+
+/// Hertz between two soft bodies, a Gmsh sphere on a block: the quarter hemisphere of
+/// tests/data/hertz-hemisphere.geo (R = 5 mm, elements of a/3 at the apex) pressed by
+/// d = 2 µm (a = √(R d) = 0.1 mm, a/R = 0.02) into the graded quarter half-space of
+/// [`graded_octant`] (k = 3 cells across its core of 1.5 a, h = a/2, truncated at 1000 a),
+/// both nearly incompressible (uncoupled neo-Hookean, ν = 0.4999, G = 1 MPa), so
+/// E* = E/(2(1 − ν²)) from the two; mortar contact, the sphere's curved face the slave.
+/// Second-order: both bodies tet10 with one pressure per element; first-order: the
+/// hemisphere's mesh lowered to order 1 and the block's hexahedra split into tet4, both with
+/// the averaged nodal pressure. The hemisphere held at its top is stiffer than Hertz's
+/// half-space by about 1 % (tests/hertz_gmsh_tet10.rs); tolerance 2 % for tet10, and the
+/// first-order meshes must be further off.
+///
+/// The block's far boundary moves and the sphere's top is held (see the comment there).
+#[test]
+fn hertz_gmsh_tet10_sphere_on_a_tet10_block() {
+    let (r, d) = (5e-3f64, 2e-6f64);
+    let (material, _) = nearly_incompressible(0.4999);
+    let nu = 0.4999;
+    let e_star = 2.0 * G * (1.0 + nu) / (2.0 * (1.0 - nu * nu));
+    let f_hertz = 4.0 / 3.0 * e_star * r.sqrt() * d.powf(1.5);
+    let a = (r * d).sqrt();
+    let k = 3;
+    let hexes = graded_octant(1.5 * a, k, 1.0 + 1.0 / k as f64, EXTENT * a);
+    let mut errors = Vec::new();
+    for (name, lower, file, element) in [
+        (
+            "tet10",
+            hexes.with_mid_side_nodes(),
+            "hertz-hemisphere-tet10.msh",
+            Formulation::FBar,
+        ),
+        (
+            "tet4 anp",
+            hexes.split_hexes_into_tets(),
+            "hertz-hemisphere-tet4.msh",
+            Formulation::AveragedNodalPressure,
+        ),
+    ] {
+        let upper = gmsh_hemisphere(file);
+        let off = lower.num_nodes();
+        let shift = |ns: &[usize]| ns.iter().map(|n| n + off).collect::<Vec<_>>();
+        let slave_set = upper.node_sets["curved"].clone();
+        let slave_faces = &upper.face_sets["curved"];
+        let local = local_faces(slave_faces, &slave_set);
+        let slave_area = tributary_areas(slave_faces, &upper.nodes, &slave_set);
+        let body = |name: &str, mesh: &Mesh| Body {
+            name: name.into(),
+            mesh: mesh.clone(),
+            material: material.clone(),
+            density: 1000.0,
+            initial_velocity: [0.0; 3],
+            element,
+            plane_strain: false,
+        };
+        // The block's far boundary moves up by d and the sphere's top is held. (Moving the
+        // top of the sphere instead, whose elements there are 0.3-1 mm, makes the first
+        // Newton iterate strain those elements alone by d/h: with κ = 5000 μ the pressure
+        // this implies leaves the tangent indefinite, and the step is cut back to 1/16; the
+        // far cells of the block are 25 mm thick.)
+        let mut push = fixed(lower.node_sets["outer"].clone(), [true, true, true]);
+        push.translation[1] = Table {
+            t: vec![0.0, 1.0],
+            v: vec![0.0, d],
+        };
+        let problem = Problem {
+            name: "hertz-gmsh-two-bodies".into(),
+            bodies: vec![body("block", &lower), body("sphere", &upper)],
+            dirichlet: vec![
+                fixed(lower.node_sets["sym_x"].clone(), [true, false, false]),
+                fixed(lower.node_sets["sym_z"].clone(), [false, false, true]),
+                push,
+                fixed(shift(&upper.node_sets["sym_x"]), [true, false, false]),
+                fixed(shift(&upper.node_sets["sym_z"]), [false, false, true]),
+                fixed(shift(&upper.node_sets["top"]), [true, true, true]),
+            ],
+            loads: vec![],
+            gravity: Default::default(),
+            time: TimeSettings {
+                t_end: 1.0,
+                quasi_static: true,
+                dt: 1.0,
+                contact_solver: ContactSolver::Semismooth,
+                ..TimeSettings::default()
+            },
+            contacts: vec![ContactPair {
+                name: "hertz".into(),
+                slave_nodes: shift(&slave_set),
+                slave_area,
+                master: Master::Faces(lower.face_sets["top"].clone()),
+                law: InterfaceLaw::rcc(0.0, None, None),
+                // Candidates: initial gap r²/2R < 3 d, i.e. r < 2.4 a.
+                detection_distance: 3.0 * d,
+                slave_quads: flat_quads(&local),
+                slave_faces: local,
+                thickness_twins: vec![],
+                discretisation: PairDiscretisation::Mortar,
+            }],
+        };
+        let clock = Instant::now();
+        let mut s = Stepper::new(Arc::new(problem)).expect("valid meshes");
+        let (mut newton, mut cutbacks, mut steps) = (0, 0, 0);
+        while !s.finished() {
+            let rep = s.step().expect("the indentation converges");
+            newton += rep.newton_iterations;
+            cutbacks += rep.cutbacks;
+            steps += 1;
+        }
+        let force = 4.0 * s.contact[0].iter().map(|c| c.force[1]).sum::<f64>();
+        let err = force / f_hertz - 1.0;
+        eprintln!(
+            "Gmsh sphere on a block, {name}, mortar: F = {force:.5e} N, {:+.2} % off Hertz \
+             {f_hertz:.5e} N, {steps} steps, {cutbacks} cut-backs, {newton} Newton iterations \
+             in the steps kept, {} unknowns, {:.1} s",
+            100.0 * err,
+            s.disc.num_dofs(),
+            clock.elapsed().as_secs_f64()
+        );
+        errors.push(err);
+    }
+    assert!(errors[0].abs() < 0.02, "tet10 {:+.2} %", 100.0 * errors[0]);
+    assert!(
+        errors[1].abs() > errors[0].abs(),
+        "first order {:+.2} % against tet10 {:+.2} %",
+        100.0 * errors[1],
+        100.0 * errors[0]
+    );
+}

@@ -114,3 +114,44 @@ fn tet_hemisphere_follows_hertz() {
     eprintln!("tet hemisphere, d = {d:e} m: F / Hertz = {ratio:.4}");
     assert!(ratio > 1.0 && ratio < 1.2, "F / Hertz = {ratio}");
 }
+
+/// scenarios/soft/ball-pull-off.toml (second-order tetrahedra from Gmsh, adhesive RCC flat),
+/// to just past its pull-off: the largest pull against the Derjaguin-Muller-Toporov force
+/// 2π w R. The interface's range √(w/C_n) = 32 µm is long against the ball's elastic response
+/// to adhesion (Maugis's λ = 0.05), the regime where 2π w R holds whatever the law's shape.
+/// Below it by the bonds beyond the detection distance D = 0.5 mm (the law's tail beyond D
+/// holds w (w/C_n)/(2 D²) per unit area: −0.2 %) and by the ball's compliance (of order λ);
+/// above it by the mesh (+1.1 % measured on this mesh, −0.4 % with elements of 0.15 mm at the
+/// apex instead of 0.25). Asserted within 3 %. At the end of the hold the force must be
+/// above DMT's 4/3 E* √R d^(3/2) − 2π w R (the held top at depth R stiffens the ball, +2.5 %
+/// of Hertz by the estimate of tests/hertz_gmsh_tet10.rs) and within 5 % of it.
+#[test]
+fn ball_pull_off_gives_the_dmt_force() {
+    let path = scenario("soft/ball-pull-off.toml");
+    // The pull-off comes at t ≈ 0.375 s; the flat's motion keeps its own end time.
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("t_end = \"= t_end\"", "t_end = 0.45");
+    let problem = adhesim_io::scenario::parse(&text, &path).unwrap();
+    let out = std::env::temp_dir().join("adhesim-test-ball-pull-off");
+    let summary = run(problem, Some(&path), &out, &mut Silent).unwrap();
+    assert_eq!(summary.outcome, Outcome::Finished);
+    let t = column(&out, "t");
+    let fy: Vec<f64> = column(&out, "flat.fy").iter().map(|f| 4.0 * f).collect();
+    let (radius, w, mu, kappa, press): (f64, f64, f64, f64, f64) =
+        (5e-3, 0.05, 0.6e6, 3e9, 0.02e-3);
+    let dmt = 2.0 * std::f64::consts::PI * w * radius;
+    let pull = -fy.iter().copied().fold(f64::INFINITY, f64::min);
+    let nu = (3.0 * kappa - 2.0 * mu) / (2.0 * (3.0 * kappa + mu));
+    let e_star = 2.0 * mu * (1.0 + nu) / (1.0 - nu * nu);
+    let hold = fy[t.iter().position(|&x| (x - 0.15).abs() < 1e-9).unwrap()];
+    let loaded = 4.0 / 3.0 * e_star * radius.sqrt() * press.powf(1.5) - dmt;
+    eprintln!(
+        "ball pull-off: largest pull {pull:.5e} N, 2π w R = {dmt:.5e} N, ratio {:.4}; \
+         end of hold {hold:.5e} N, DMT {loaded:.5e} N, ratio {:.4}",
+        pull / dmt,
+        hold / loaded
+    );
+    assert!((pull / dmt - 1.0).abs() < 0.03, "pull-off {pull} N");
+    assert!(hold > loaded && hold < 1.05 * loaded, "hold {hold} N");
+}

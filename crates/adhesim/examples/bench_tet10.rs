@@ -1,0 +1,156 @@
+//! Assembly cost of the quadratic tetrahedron (tet10) against the hexahedron (hex8), on an
+//! n³ cube of the nearly incompressible neo-Hookean solid (E = 1 MPa, ν = 0.4999) deformed by
+//! a smooth finite displacement field, on one thread:
+//!
+//! 1. one element's `element_response` with tangent, hex8 (8 Gauss points) and tet10
+//!    (4 points) (µs);
+//! 2. `Discretisation::assemble(u, true)` (internal force and tangent into the global
+//!    arrays) per element: the n³ hexahedra, standard and F-bar, against the same cube split
+//!    into 6 n³ tetrahedra with a node at the middle of every edge, standard and with one
+//!    pressure per element (`Formulation::FBar`) (µs), and the whole mesh's assembly.
+//!
+//! Each pair (hex8, tet10) is timed alternately after one warm-up run of each, so that both
+//! see the same machine load; reported are the median of each and the median of the
+//! per-pair ratios. Usage: `cargo run --release --example bench_tet10 -- [n] [reps]`.
+
+use adhesim::assembly::Discretisation;
+use adhesim::element::{element_response, hex8_geometry, tet10_geometry, TET10};
+use adhesim::fbar::Formulation;
+use adhesim::material::{Hyperelastic, UncoupledNeoHookean};
+use adhesim::mesh::generate;
+use std::f64::consts::PI;
+use std::hint::black_box;
+use std::sync::Arc;
+use std::time::Instant;
+
+fn displacement(x: [f64; 3]) -> [f64; 3] {
+    let s = (PI * x[0]).sin() * (PI * x[1]).sin() * (PI * x[2]).sin();
+    [
+        0.05 * x[0] + 0.03 * x[1] + 0.01 * s,
+        -0.025 * x[1] + 0.02 * x[2] + 0.005 * s,
+        0.01 * x[0] - 0.025 * x[2] - 0.008 * s,
+    ]
+}
+
+fn time(f: &mut impl FnMut()) -> f64 {
+    let t0 = Instant::now();
+    f();
+    t0.elapsed().as_secs_f64()
+}
+
+fn median_of(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Alternating timings of `a` and `b` after one warm-up of each: (median a, median b,
+/// median of the per-pair ratios b/a) [s].
+fn alternate(reps: usize, mut a: impl FnMut(), mut b: impl FnMut()) -> (f64, f64, f64) {
+    a();
+    b();
+    let (mut ta, mut tb, mut r) = (vec![], vec![], vec![]);
+    for _ in 0..reps {
+        let x = time(&mut a);
+        let y = time(&mut b);
+        ta.push(x);
+        tb.push(y);
+        r.push(y / x);
+    }
+    (median_of(ta), median_of(tb), median_of(r))
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let n: usize = args.first().and_then(|s| s.parse().ok()).unwrap_or(20);
+    let reps: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(7);
+    let material: Arc<dyn Hyperelastic> =
+        Arc::new(UncoupledNeoHookean::from_young_poisson(1.0e6, 0.4999));
+    let mat = &*material;
+
+    // 1. One element of each, in the same cube cell.
+    let mesh = generate::block([1.0, 1.0, 1.0], [n, n, n]);
+    let tet10 = mesh.with_mid_side_nodes();
+    let hex = mesh.hexes()[0];
+    let xh: [[f64; 3]; 8] = hex.map(|a| mesh.nodes[a]);
+    let gh = hex8_geometry(&xh).expect("valid element");
+    let uh: [[f64; 3]; 8] = xh.map(displacement);
+    let tet = tet10.cells_of::<10>(&TET10)[0];
+    let xt: [[f64; 3]; 10] = tet.map(|a| tet10.nodes[a]);
+    let gt = tet10_geometry(&xt).expect("valid element");
+    let ut: [[f64; 3]; 10] = xt.map(displacement);
+    let iters = 20_000;
+    let (hex_el, tet_el, el_ratio) = alternate(
+        reps,
+        || {
+            for _ in 0..iters {
+                black_box(element_response(black_box(&gh), black_box(&uh), mat, true));
+            }
+        },
+        || {
+            for _ in 0..iters {
+                black_box(element_response(black_box(&gt), black_box(&ut), mat, true));
+            }
+        },
+    );
+    let (hex_el, tet_el) = (hex_el / iters as f64, tet_el / iters as f64);
+
+    // 2. Assembly on one thread.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("thread pool");
+    let uh: Vec<f64> = mesh.nodes.iter().flat_map(|&p| displacement(p)).collect();
+    let ut: Vec<f64> = tet10.nodes.iter().flat_map(|&p| displacement(p)).collect();
+    let nh = mesh.hexes().len() as f64;
+    let nt = tet10.cells_of::<10>(&TET10).len() as f64;
+    println!(
+        "{n}³ cube: {} hex8 ({} nodes), {} tet10 ({} nodes), one thread, {reps} alternating pairs",
+        nh,
+        mesh.num_nodes(),
+        nt,
+        tet10.num_nodes()
+    );
+    println!();
+    println!("| measurement | hex8 [µs] | tet10 [µs] | median of pair ratios tet10/hex8 |");
+    println!("|---|---|---|---|");
+    println!(
+        "| one element's response with tangent | {:.2} | {:.2} | {:.2} |",
+        hex_el * 1e6,
+        tet_el * 1e6,
+        el_ratio
+    );
+    for (name, f) in [
+        ("standard", Formulation::Standard),
+        ("F-bar / one pressure per element", Formulation::FBar),
+    ] {
+        let dh = Discretisation::with_formulations(&[(&mesh, material.clone())], &[f])
+            .expect("valid mesh");
+        let dt = Discretisation::with_formulations(&[(&tet10, material.clone())], &[f])
+            .expect("valid mesh");
+        let (th, tt, ratio) = pool.install(|| {
+            alternate(
+                reps,
+                || drop(black_box(dh.assemble(black_box(&uh), true))),
+                || drop(black_box(dt.assemble(black_box(&ut), true))),
+            )
+        });
+        println!(
+            "| assembly K + f per element, {name} | {:.2} | {:.2} | {:.2} |",
+            th / nh * 1e6,
+            tt / nt * 1e6,
+            ratio * nh / nt
+        );
+        println!(
+            "| assembly K + f of the whole cube, {name} [ms] | {:.1} | {:.1} | {:.2} |",
+            th * 1e3,
+            tt * 1e3,
+            ratio
+        );
+        println!(
+            "| stored tangent values, {name} | {} | {} | {:.2} |",
+            dh.pattern.nnz(),
+            dt.pattern.nnz(),
+            dt.pattern.nnz() as f64 / dh.pattern.nnz() as f64
+        );
+    }
+}
