@@ -734,7 +734,7 @@ fn element_cost_table() {
         let c = 1.5 * a;
         let hexes = graded_octant(c, k, 1.0 + 1.0 / k as f64, EXTENT * a);
         let tets = hexes.split_hexes_into_tets();
-        let tet10 = hexes.with_mid_side_nodes();
+        let tet10 = tets.with_mid_side_nodes();
         let run = |mesh: &Mesh, element| {
             indent_on(
                 mesh.clone(),

@@ -29,7 +29,7 @@ fn cook_tet10(n: usize, element: Formulation) -> f64 {
         let (xi, eta) = (x[0], x[1]);
         *x = [48.0 * xi, 44.0 * xi + eta * (44.0 - 28.0 * xi), x[2]];
     }
-    let mesh = mesh.with_mid_side_nodes();
+    let mesh = mesh.split_hexes_into_tets().with_mid_side_nodes();
     let material = UncoupledNeoHookean::from_young_poisson(250.0, 0.4999);
     let mut p = one_body(
         mesh.clone(),
