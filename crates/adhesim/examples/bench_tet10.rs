@@ -9,7 +9,10 @@
 //!    into 6 n³ tetrahedra with a node at the middle of every edge, standard and with one
 //!    pressure per element (`Formulation::FBar`) (µs), and the whole mesh's assembly.
 //!
-//! Each pair (hex8, tet10) is timed alternately after one warm-up run of each, so that both
+//! 3. the same assembly per element of the cube's n³ 20-node hexahedra (hex20, 27 Gauss
+//!    points), standard and F-bar, against hex8.
+//!
+//! Each pair (hex8, tet10 or hex20) is timed alternately after one warm-up run of each, so that both
 //! see the same machine load; reported are the median of each and the median of the
 //! per-pair ratios. Usage: `cargo run --release --example bench_tet10 -- [n] [reps]`.
 
@@ -69,7 +72,8 @@ fn main() {
 
     // 1. One element of each, in the same cube cell.
     let mesh = generate::block([1.0, 1.0, 1.0], [n, n, n]);
-    let tet10 = mesh.with_mid_side_nodes();
+    let tet10 = mesh.split_hexes_into_tets().with_mid_side_nodes();
+    let hex20 = mesh.with_mid_side_nodes();
     let hex = mesh.hexes()[0];
     let xh: [[f64; 3]; 8] = hex.map(|a| mesh.nodes[a]);
     let gh = hex8_geometry(&xh).expect("valid element");
@@ -151,6 +155,51 @@ fn main() {
             dh.pattern.nnz(),
             dt.pattern.nnz(),
             dt.pattern.nnz() as f64 / dh.pattern.nnz() as f64
+        );
+    }
+    hex20_assembly(&mesh, &hex20, &material, reps, &pool);
+}
+
+/// Item 3: assembly per element of the hex20 cube `hex20` against the hex8 cube `mesh`.
+fn hex20_assembly(
+    mesh: &adhesim::mesh::Mesh,
+    hex20: &adhesim::mesh::Mesh,
+    material: &Arc<dyn Hyperelastic>,
+    reps: usize,
+    pool: &rayon::ThreadPool,
+) {
+    let uh: Vec<f64> = mesh.nodes.iter().flat_map(|&p| displacement(p)).collect();
+    let uq: Vec<f64> = hex20.nodes.iter().flat_map(|&p| displacement(p)).collect();
+    let cells = mesh.hexes().len() as f64;
+    println!();
+    println!("| measurement | hex8 [µs] | hex20 [µs] | median of pair ratios hex20/hex8 |");
+    println!("|---|---|---|---|");
+    for (name, f) in [
+        ("standard", Formulation::Standard),
+        ("F-bar", Formulation::FBar),
+    ] {
+        let dh = Discretisation::with_formulations(&[(mesh, material.clone())], &[f])
+            .expect("valid mesh");
+        let dq = Discretisation::with_formulations(&[(hex20, material.clone())], &[f])
+            .expect("valid mesh");
+        let (th, tq, ratio) = pool.install(|| {
+            alternate(
+                reps,
+                || drop(black_box(dh.assemble(black_box(&uh), true))),
+                || drop(black_box(dq.assemble(black_box(&uq), true))),
+            )
+        });
+        println!(
+            "| assembly K + f per element, {name} | {:.2} | {:.2} | {:.2} |",
+            th / cells * 1e6,
+            tq / cells * 1e6,
+            ratio
+        );
+        println!(
+            "| stored tangent values, {name} | {} | {} | {:.2} |",
+            dh.pattern.nnz(),
+            dq.pattern.nnz(),
+            dq.pattern.nnz() as f64 / dh.pattern.nnz() as f64
         );
     }
 }
