@@ -1,5 +1,5 @@
-//! Deformable on deformable: two Blatz-Ko blocks with non-matching meshes pressed together
-//! (node-to-face contact). The support reaction under the lower block balances the force
+//! Deformable on deformable: two Blatz-Ko blocks with non-matching meshes pressed together,
+//! with node-to-surface contact and with mortar. The support reaction under the lower block balances the force
 //! applied on the upper one, the contact forces act equal and opposite on the two bodies,
 //! and the contact pressure is symmetric about the blocks' mid-planes.
 
@@ -43,7 +43,15 @@ detection_distance = 1e-3
 
 #[test]
 fn pressed_blocks_balance_forces_and_share_a_symmetric_pressure() {
-    let problem = adhesim_io::scenario::parse(SCENARIO, Path::new("two_blocks.toml"))
+    for discretisation in ["node-to-surface", "mortar"] {
+        eprintln!("{discretisation}:");
+        pressed_blocks(discretisation);
+    }
+}
+
+fn pressed_blocks(discretisation: &str) {
+    let text = format!("{SCENARIO}discretisation = {discretisation:?}\n");
+    let problem = adhesim_io::scenario::parse(&text, Path::new("two_blocks.toml"))
         .unwrap()
         .problem;
     let lower = &problem.bodies[0].mesh;
