@@ -24,7 +24,14 @@ fn seeds() -> &'static [Seed] {
     SEEDS.get_or_init(|| {
         let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios");
         let mut out = Vec::new();
-        for dir in [root.clone(), root.join("paper"), root.join("gmsh")] {
+        for dir in [
+            root.clone(),
+            root.join("paper"),
+            root.join("gmsh"),
+            root.join("soft"),
+            root.join("contact"),
+            root.join("interface"),
+        ] {
             let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
                 .unwrap()
                 .map(|e| e.unwrap().path())
