@@ -177,11 +177,18 @@ pub fn augmented_point(
     }
 }
 
-/// Upper bound of the stiffness [N/m] that K̄ shows at a contact point: 1/(e K̄⁻¹ e) ≤ e K̄ e
-/// along any unit direction e, taken as 1/(Σ_s w_s²/k_s + Σ_m w_m²/k_m) from the largest free
-/// diagonal entry of K̄ at each slave node (k_s, weight w_s: 1, or shared along a plane-strain
-/// line) and at each master node (k_m). `diagonal` holds K̄_ii;
-/// constrained unknowns are skipped. Returns `None` when every unknown involved is constrained.
+/// Estimate of the stiffness [N/m] that K̄ shows at a contact point, from the largest free
+/// diagonal entry k_n of K̄ at each node of its stencil (`diagonal` holds K̄_ii; constrained
+/// unknowns are skipped). Returns `None` when every unknown involved is constrained.
+///
+/// - A node-to-surface site (one slave node, or a plane-strain line of them, against a face's
+///   nodes): 1/(Σ_n w_n²/k_n), the nodes taken as independent springs, an upper bound
+///   since 1/(e K̄⁻¹ e) ≤ e K̄ e along any unit direction e.
+/// - A mortar site (each side the weighted mean of a patch of neighbouring nodes): the nodes
+///   of a patch move together, so each side is one spring of compliance (Σ_n |w_n|/√k_n)²
+///   and the site 1/Σ_sides. The independent-spring bound would be several times too stiff
+///   here (by about half the nodes of a patch), and a ρ that large makes the semismooth
+///   solve with friction wander (docs/contact-surfaces.md).
 pub fn point_stiffness(pt: &ContactPoint, diagonal: &[f64], constrained: &[bool]) -> Option<f64> {
     let node_k = |n: usize| -> Option<f64> {
         (0..3)
@@ -190,12 +197,23 @@ pub fn point_stiffness(pt: &ContactPoint, diagonal: &[f64], constrained: &[bool]
             .filter(|v| v.is_finite() && *v > 0.0)
             .reduce(f64::max)
     };
-    let mut compliance = 0.0;
-    for (m, w) in pt.stencil() {
-        if let Some(k) = node_k(m) {
-            compliance += w * w / k;
+    let compliance = if pt.slave_weights.is_empty() {
+        let mut compliance = 0.0;
+        for (m, w) in pt.stencil() {
+            if let Some(k) = node_k(m) {
+                compliance += w * w / k;
+            }
         }
-    }
+        compliance
+    } else {
+        let patch = |nodes: &mut dyn Iterator<Item = (usize, f64)>| -> f64 {
+            let sum: f64 = nodes
+                .filter_map(|(n, w)| node_k(n).map(|k| w.abs() / k.sqrt()))
+                .sum();
+            sum * sum
+        };
+        patch(&mut pt.slave_nodes()) + patch(&mut pt.master.iter().copied())
+    };
     (compliance > 0.0).then(|| 1.0 / compliance)
 }
 
