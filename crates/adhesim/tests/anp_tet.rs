@@ -33,20 +33,8 @@ const ANP: Formulation = Formulation::AveragedNodalPressure;
 /// to `shake` of an element size.
 fn shaken_tet_cube(n: usize, shake: f64, seed: u64) -> (Mesh, Vec<usize>) {
     let mut mesh = generate::block([1.0, 1.0, 1.0], [n, n, n]).split_hexes_into_tets();
-    let boundary: std::collections::BTreeSet<usize> = mesh
-        .boundary_faces()
-        .iter()
-        .flat_map(|f| f.nodes().to_vec())
-        .collect();
-    let mut rng = Rng(seed);
-    for i in 0..mesh.num_nodes() {
-        if !boundary.contains(&i) {
-            for k in 0..3 {
-                mesh.nodes[i][k] += shake / n as f64 * rng.next();
-            }
-        }
-    }
-    (mesh, boundary.into_iter().collect())
+    let boundary = shake_interior(&mut mesh, n, shake, seed);
+    (mesh, boundary)
 }
 
 #[test]

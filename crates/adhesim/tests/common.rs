@@ -90,16 +90,53 @@ pub fn solve(p: Problem) -> Stepper {
     s
 }
 
-/// Patch test: prescribes u = A x on the `boundary` nodes of `mesh` (A with stretches and
-/// shears of 10-30 % and J ≠ 1) for a nearly incompressible neo-Hookean body of elements
-/// `element`, and returns the largest nodal error against A x [m] (the element must
-/// reproduce the homogeneous deformation exactly, to the Newton tolerance).
-pub fn homogeneous_patch_error(mesh: &Mesh, boundary: &[usize], element: Formulation) -> f64 {
-    let a = [[0.3, 0.2, 0.0], [0.0, -0.1, 0.05], [0.1, 0.0, 0.1]];
+/// Moves every node of `mesh` off its boundary at random by up to `shake` / `n` in each
+/// direction (`n` elements along the unit cube's side) and returns the boundary nodes.
+pub fn shake_interior(mesh: &mut Mesh, n: usize, shake: f64, seed: u64) -> Vec<usize> {
+    let boundary: std::collections::BTreeSet<usize> = mesh
+        .boundary_faces()
+        .iter()
+        .flat_map(|f| f.nodes().to_vec())
+        .collect();
+    let mut rng = Rng(seed);
+    for i in 0..mesh.num_nodes() {
+        if !boundary.contains(&i) {
+            for k in 0..3 {
+                mesh.nodes[i][k] += shake / n as f64 * rng.next();
+            }
+        }
+    }
+    boundary.into_iter().collect()
+}
+
+/// Puts the mid-edge nodes of the `N`-node cells of type `element` (corners first, then one
+/// node per edge of `edges`) back at the middle of their straight edges.
+pub fn straighten_mid_edges<const N: usize>(
+    mesh: &mut Mesh,
+    element: &adhesim::element::ElementType,
+    edges: &[[usize; 2]],
+) {
+    let corners = N - edges.len();
+    let cells = mesh.cells_of::<N>(element).to_vec();
+    for c in &cells {
+        for (m, [i, j]) in edges.iter().enumerate() {
+            let (a, b) = (mesh.nodes[c[*i]], mesh.nodes[c[*j]]);
+            mesh.nodes[c[corners + m]] = std::array::from_fn(|k| 0.5 * (a[k] + b[k]));
+        }
+    }
+}
+
+/// Prescribes u = A x on the `boundary` nodes of `mesh` for a body of `material` with element
+/// kinematics `element`, solves, and returns the largest nodal error against A x [m].
+fn patch_error(
+    mesh: &Mesh,
+    boundary: &[usize],
+    material: Arc<dyn Hyperelastic>,
+    element: Formulation,
+    a: [[f64; 3]; 3],
+) -> f64 {
     let field =
         |x: [f64; 3]| -> [f64; 3] { std::array::from_fn(|i| (0..3).map(|j| a[i][j] * x[j]).sum()) };
-    let material: Arc<dyn Hyperelastic> =
-        Arc::new(UncoupledNeoHookean::from_young_poisson(1.0e6, 0.45));
     let mut p = one_body(mesh.clone(), material, 1000.0, quasi_static(1.0, 1.0));
     p.bodies[0].element = element;
     for &n in boundary {
@@ -118,6 +155,31 @@ pub fn homogeneous_patch_error(mesh: &Mesh, boundary: &[usize], element: Formula
         }
     }
     err
+}
+
+/// Patch test: prescribes u = A x on the `boundary` nodes of `mesh` (A with stretches and
+/// shears of 10-30 % and J ≠ 1) for a nearly incompressible neo-Hookean body of elements
+/// `element`, and returns the largest nodal error against A x [m] (the element must
+/// reproduce the homogeneous deformation exactly, to the Newton tolerance).
+pub fn homogeneous_patch_error(mesh: &Mesh, boundary: &[usize], element: Formulation) -> f64 {
+    let a = [[0.3, 0.2, 0.0], [0.0, -0.1, 0.05], [0.1, 0.0, 0.1]];
+    let material: Arc<dyn Hyperelastic> =
+        Arc::new(UncoupledNeoHookean::from_young_poisson(1.0e6, 0.45));
+    patch_error(mesh, boundary, material, element, a)
+}
+
+/// Small-strain patch test: u = A x (strains of 1e-4 to 2e-3) prescribed on the `boundary`
+/// nodes of a linear elastic body (E = 1 MPa, ν = 0.3); the largest nodal error [m].
+pub fn linear_patch_error(mesh: &Mesh, boundary: &[usize]) -> f64 {
+    let a = [
+        [1e-3, 2e-4, -3e-4],
+        [5e-4, -1e-3, 1e-4],
+        [-2e-4, 3e-4, 2e-3],
+    ];
+    let material: Arc<dyn Hyperelastic> = Arc::new(
+        adhesim::material::LinearElastic::from_young_poisson(1e6, 0.3),
+    );
+    patch_error(mesh, boundary, material, Formulation::Standard, a)
 }
 
 /// The cross-section of [`cantilever_beam`].

@@ -20,7 +20,7 @@ use adhesim::element::{
     element_response, hex20_geometry, hex20_shape, Element, Hex20, HEX20, HEX20_EDGES, QUAD8,
 };
 use adhesim::fbar::{fbar_element_response, Formulation};
-use adhesim::material::{Hyperelastic, LinearElastic, NeoHookean, UncoupledNeoHookean};
+use adhesim::material::{Hyperelastic, NeoHookean, UncoupledNeoHookean};
 use adhesim::mesh::Mesh;
 use std::path::Path;
 use std::sync::Arc;
@@ -30,13 +30,7 @@ use common::*;
 
 /// Moves every mid-edge node of every hex20 of `mesh` to the middle of its edge.
 fn straighten_edges(mesh: &mut Mesh) {
-    let cells = mesh.cells_of::<20>(&HEX20).to_vec();
-    for c in &cells {
-        for (m, [i, j]) in HEX20_EDGES.iter().enumerate() {
-            let (a, b) = (mesh.nodes[c[*i]], mesh.nodes[c[*j]]);
-            mesh.nodes[c[8 + m]] = std::array::from_fn(|k| 0.5 * (a[k] + b[k]));
-        }
-    }
+    straighten_mid_edges::<20>(mesh, &HEX20, &HEX20_EDGES);
 }
 
 /// A unit cube of n³ hex20, every corner node off the boundary moved at random by up to
@@ -44,22 +38,10 @@ fn straighten_edges(mesh: &mut Mesh) {
 /// (straight) edges, and its boundary nodes.
 fn shaken_cube(n: usize, shake: f64, seed: u64) -> (Mesh, Vec<usize>) {
     let mut mesh = Cells::Hex20.block([1.0; 3], [n, n, n]);
-    let boundary: std::collections::BTreeSet<usize> = mesh
-        .boundary_faces()
-        .iter()
-        .flat_map(|f| f.nodes().to_vec())
-        .collect();
-    let mut rng = Rng(seed);
-    for i in 0..mesh.num_nodes() {
-        if !boundary.contains(&i) {
-            for k in 0..3 {
-                mesh.nodes[i][k] += shake / n as f64 * rng.next();
-            }
-        }
-    }
+    let boundary = shake_interior(&mut mesh, n, shake, seed);
     straighten_edges(&mut mesh);
     assert!(adhesim::mesh::quality::inverted_cells(&mesh).is_empty());
-    (mesh, boundary.into_iter().collect())
+    (mesh, boundary)
 }
 
 #[test]
@@ -85,30 +67,7 @@ fn mesh_of_hex20_is_conforming_and_its_faces_are_eight_node_quadrilaterals() {
 #[test]
 fn small_strain_patch_reproduces_a_linear_field() {
     let (mesh, boundary) = shaken_cube(2, 0.2, 11);
-    let a = [
-        [1e-3, 2e-4, -3e-4],
-        [5e-4, -1e-3, 1e-4],
-        [-2e-4, 3e-4, 2e-3],
-    ];
-    let material: Arc<dyn Hyperelastic> = Arc::new(LinearElastic::from_young_poisson(1e6, 0.3));
-    let field =
-        |x: [f64; 3]| -> [f64; 3] { std::array::from_fn(|i| (0..3).map(|j| a[i][j] * x[j]).sum()) };
-    let mut p = one_body(mesh.clone(), material, 1000.0, quasi_static(1.0, 1.0));
-    for &n in &boundary {
-        p.dirichlet.push(adhesim::problem::Dirichlet {
-            nodes: vec![n],
-            components: [true; 3],
-            translation: field(mesh.nodes[n]).map(ramp),
-            rotation: None,
-        });
-    }
-    let s = solve(p);
-    let mut err: f64 = 0.0;
-    for (i, &x) in mesh.nodes.iter().enumerate() {
-        for (k, uk) in field(x).iter().enumerate() {
-            err = err.max((s.state.u[3 * i + k] - uk).abs());
-        }
-    }
+    let err = linear_patch_error(&mesh, &boundary);
     eprintln!("hex20 small-strain patch: max nodal error {err:.2e} m");
     // Displacements ~1e-3 m; the solve is linear, so the error is round-off.
     assert!(err < 1e-13, "max nodal error {err:e} m");

@@ -15,7 +15,7 @@
 
 use adhesim::element::{element_response, tet10_geometry, Tet10, TET10};
 use adhesim::fbar::{fbar_element_response, volume_ratio, Formulation};
-use adhesim::material::{Hyperelastic, LinearElastic, NeoHookean, UncoupledNeoHookean};
+use adhesim::material::{Hyperelastic, NeoHookean, UncoupledNeoHookean};
 use adhesim::mesh::Mesh;
 use std::sync::Arc;
 
@@ -29,28 +29,10 @@ use common::*;
 /// test only approximately, as with the usual C3D10.)
 fn shaken_cube(n: usize, shake: f64, seed: u64) -> (Mesh, Vec<usize>) {
     let mut mesh = Cells::Tet10.block([1.0; 3], [n, n, n]);
-    let boundary: std::collections::BTreeSet<usize> = mesh
-        .boundary_faces()
-        .iter()
-        .flat_map(|f| f.nodes().to_vec())
-        .collect();
-    let mut rng = Rng(seed);
-    for i in 0..mesh.num_nodes() {
-        if !boundary.contains(&i) {
-            for k in 0..3 {
-                mesh.nodes[i][k] += shake / n as f64 * rng.next();
-            }
-        }
-    }
-    let cells = mesh.cells_of::<10>(&TET10).to_vec();
-    for c in &cells {
-        for (m, [i, j]) in adhesim::element::TET10_EDGES.iter().enumerate() {
-            let (a, b) = (mesh.nodes[c[*i]], mesh.nodes[c[*j]]);
-            mesh.nodes[c[4 + m]] = std::array::from_fn(|k| 0.5 * (a[k] + b[k]));
-        }
-    }
+    let boundary = shake_interior(&mut mesh, n, shake, seed);
+    straighten_mid_edges::<10>(&mut mesh, &TET10, &adhesim::element::TET10_EDGES);
     assert!(adhesim::mesh::quality::inverted_cells(&mesh).is_empty());
-    (mesh, boundary.into_iter().collect())
+    (mesh, boundary)
 }
 
 #[test]
@@ -74,30 +56,7 @@ fn mesh_of_tet10_is_conforming_and_its_faces_are_six_node_triangles() {
 #[test]
 fn small_strain_patch_reproduces_a_linear_field() {
     let (mesh, boundary) = shaken_cube(2, 0.2, 11);
-    let a = [
-        [1e-3, 2e-4, -3e-4],
-        [5e-4, -1e-3, 1e-4],
-        [-2e-4, 3e-4, 2e-3],
-    ];
-    let material: Arc<dyn Hyperelastic> = Arc::new(LinearElastic::from_young_poisson(1e6, 0.3));
-    let field =
-        |x: [f64; 3]| -> [f64; 3] { std::array::from_fn(|i| (0..3).map(|j| a[i][j] * x[j]).sum()) };
-    let mut p = one_body(mesh.clone(), material, 1000.0, quasi_static(1.0, 1.0));
-    for &n in &boundary {
-        p.dirichlet.push(adhesim::problem::Dirichlet {
-            nodes: vec![n],
-            components: [true; 3],
-            translation: field(mesh.nodes[n]).map(ramp),
-            rotation: None,
-        });
-    }
-    let s = solve(p);
-    let mut err: f64 = 0.0;
-    for (i, &x) in mesh.nodes.iter().enumerate() {
-        for (k, uk) in field(x).iter().enumerate() {
-            err = err.max((s.state.u[3 * i + k] - uk).abs());
-        }
-    }
+    let err = linear_patch_error(&mesh, &boundary);
     // Displacements ~1e-3 m; the solve is linear, so the error is round-off.
     assert!(err < 1e-13, "max nodal error {err:e} m");
 }

@@ -508,9 +508,7 @@ pub fn frame_from_normal(n: [f64; 3]) -> [[f64; 3]; 3] {
 }
 
 /// `a` scaled to unit length; e_y for the zero vector.
-pub(super) fn unit(a: Vec3) -> Vec3 {
-    crate::element::face::unit(a)
-}
+pub(super) use crate::element::face::unit;
 
 #[cfg(test)]
 mod tests {

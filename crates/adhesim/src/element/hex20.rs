@@ -17,6 +17,7 @@
 use super::face::{
     gauss_newton_projection, onto_square, square_quadrature, FaceProjection, FaceType, LocalFace,
 };
+use super::hex8::HEX_CORNER_FRAMES;
 use super::{DegenerateElement, Element, ElementType, GaussPoint, Stabilisation};
 use crate::Vec3;
 
@@ -77,16 +78,7 @@ pub static HEX20: ElementType = ElementType {
         quad8(&[0, 4, 7, 3, 16, 15, 19, 11]), // ξ = −1
         quad8(&[1, 2, 6, 5, 9, 18, 13, 17]),  // ξ = +1
     ],
-    corner_frames: &[
-        [0, 1, 3, 4],
-        [1, 2, 0, 5],
-        [2, 3, 1, 6],
-        [3, 0, 2, 7],
-        [4, 7, 5, 0],
-        [5, 4, 6, 1],
-        [6, 5, 7, 2],
-        [7, 6, 4, 3],
-    ],
+    corner_frames: &HEX_CORNER_FRAMES,
     inverted_inside: |x| {
         let x: &[[f64; 3]; 20] = x.try_into().expect("a hex20 has 20 nodes");
         hex20_inverted(x)

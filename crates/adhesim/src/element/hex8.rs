@@ -99,6 +99,19 @@ fn project_on_quad4(p: &[Vec3], x: Vec3) -> FaceProjection {
 }
 
 /// The hex8 row of the element-type table.
+/// The corner frames of a hexahedron (VTK order): each corner with its three neighbours
+/// along the edges, right-handed; hex20 shares its corners'.
+pub(super) const HEX_CORNER_FRAMES: [[usize; 4]; 8] = [
+    [0, 1, 3, 4],
+    [1, 2, 0, 5],
+    [2, 3, 1, 6],
+    [3, 0, 2, 7],
+    [4, 7, 5, 0],
+    [5, 4, 6, 1],
+    [6, 5, 7, 2],
+    [7, 6, 4, 3],
+];
+
 pub static HEX8: ElementType = ElementType {
     name: "hex8",
     nodes: 8,
@@ -114,16 +127,7 @@ pub static HEX8: ElementType = ElementType {
         quad4(&[0, 4, 7, 3]), // ξ = −1
         quad4(&[1, 2, 6, 5]), // ξ = +1
     ],
-    corner_frames: &[
-        [0, 1, 3, 4],
-        [1, 2, 0, 5],
-        [2, 3, 1, 6],
-        [3, 0, 2, 7],
-        [4, 7, 5, 0],
-        [5, 4, 6, 1],
-        [6, 5, 7, 2],
-        [7, 6, 4, 3],
-    ],
+    corner_frames: &HEX_CORNER_FRAMES,
     inverted_inside: |x| {
         let x: &[[f64; 3]; 8] = x.try_into().expect("a hex8 has 8 nodes");
         hex8_gauss_dets(x).iter().any(|&d| d <= 0.0)
