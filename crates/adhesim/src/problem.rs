@@ -110,6 +110,12 @@ pub enum NewtonMethod {
     /// when they do not; a step that does not converge so is solved again with full Newton.
     /// The semismooth contact solve factorises as under `Full`.
     Modified,
+    /// Each Newton correction is solved with the matrix of its own iterate, by GMRES
+    /// preconditioned with the factorisation the loop keeps, within and across steps
+    /// ([`crate::time::factor_reuse`]); the loop factorises again when GMRES does not reach its
+    /// tolerance or needed many iterations. The semismooth contact solve factorises as under
+    /// `Full`.
+    Preconditioned,
 }
 
 /// How the contact conditions are solved in each Newton iteration (docs/contact-solver.md).

@@ -11,7 +11,9 @@
 //! for that map T, in which a tied node keeps only a unit diagonal; solving adds a tied node's
 //! right-hand side to its representative's and copies the solution back.
 
-use crate::linalg::{BlockPattern, LinalgError, LinearSolve, SparseCholesky};
+use crate::linalg::{
+    gmres, BlockPattern, KrylovLimits, KrylovOutcome, LinalgError, LinearSolve, SparseCholesky,
+};
 use std::collections::BTreeSet;
 
 /// K̄ in the (possibly extended) pattern, with its factorisation.
@@ -275,6 +277,31 @@ impl SystemMatrix {
                 }
             }
         }
+    }
+}
+
+impl SystemMatrix {
+    /// Solves K̄ x = b in place by GMRES on the matrix as its values now are (the Dirichlet
+    /// conditions and ties applied, [`Self::apply_conditions`]), preconditioned by the
+    /// factorisation in use, which may be of earlier values (docs/scaling.md). `rhs` holds b
+    /// on all unknowns, as for [`Self::solve_in_place`]; on return it holds GMRES's x, with
+    /// the tied nodes' unknowns copied from their representatives'. Needs a factorisation.
+    pub fn solve_preconditioned(&mut self, rhs: &mut [f64], limits: KrylovLimits) -> KrylovOutcome {
+        for &(t, r) in &self.tied_nodes {
+            for k in 0..3 {
+                rhs[3 * r + k] += rhs[3 * t + k];
+                rhs[3 * t + k] = 0.0;
+            }
+        }
+        let (pattern, values, factor) = (&self.pattern, &self.values, &mut self.chol);
+        let apply = |v: &[f64], out: &mut [f64]| {
+            out.iter_mut().for_each(|o| *o = 0.0);
+            pattern.symmetric_matvec(values, v, out);
+        };
+        let (x, outcome) = gmres(apply, |v| factor.solve_in_place(v), rhs, limits);
+        rhs.copy_from_slice(&x);
+        self.expand_tied(rhs);
+        outcome
     }
 }
 

@@ -108,13 +108,15 @@ fn newton(t: &FileTime, d: &TimeSettings, ctx: &Ctx) -> Result<(f64, usize), Sce
 }
 
 /// Whether `time.newton` asks for a new factorisation at every iteration (`"full"`, the
-/// default) or keeps one while the iterations converge (`"modified"`).
+/// default), keeps one while the iterations converge (`"modified"`), or keeps one as the
+/// preconditioner of an iterative solve of each correction (`"preconditioned"`).
 fn newton_method(t: &FileTime, ctx: &Ctx) -> Result<NewtonMethod, ScenarioError> {
     match t.newton.as_deref() {
         None | Some("full") => Ok(NewtonMethod::Full),
         Some("modified") => Ok(NewtonMethod::Modified),
+        Some("preconditioned") => Ok(NewtonMethod::Preconditioned),
         Some(m) => Err(ctx.err(format!(
-            "`time.newton` = {m:?}; valid values are \"full\" and \"modified\""
+            "`time.newton` = {m:?}; valid values are \"full\", \"modified\" and \"preconditioned\""
         ))),
     }
 }

@@ -74,7 +74,12 @@ pub fn augmented_dry_force(mu: f64, rho: f64, lambda: Vec3, x: Vec3) -> DryForce
     let tau = [lambda[0] - rho * x[0], lambda[1] - rho * x[1]];
     let norm_tau = tau[0].hypot(tau[1]);
     let radius = mu * lambda[2].max(0.0);
-    let (rt, sliding, tangential_energy) = if norm_tau <= radius {
+    let (rt, sliding, tangential_energy) = if mu == 0.0 {
+        // Frictionless: no tangential force whatever τ, and no tangential stiffness (the
+        // disk's test below would call τ = 0 sticking and pin the tangential motion for an
+        // iteration).
+        ([0.0, 0.0], true, 0.0)
+    } else if norm_tau <= radius {
         stiffness[(0, 0)] = rho;
         stiffness[(1, 1)] = rho;
         (tau, false, 0.5 * norm_tau * norm_tau)
@@ -279,6 +284,32 @@ pub fn defect_norm(evals: &[AugmentedPoint]) -> f64 {
 
 #[cfg(test)]
 mod tests {
+
+    /// Frictionless, the tangential force is zero whatever τ, so −∂r/∂x has no tangential
+    /// part: at τ = 0 (a closed point with no slip yet) the law neither sticks nor pins the
+    /// tangential motion. Checked against central differences of the force.
+    #[test]
+    fn a_frictionless_point_has_no_tangential_stiffness() {
+        let (rho, lambda) = (1e6, Vec3::new(0.0, 0.0, 2.0));
+        for x in [Vec3::new(0.0, 0.0, -1e-6), Vec3::new(3e-7, -1e-7, -1e-6)] {
+            let d = augmented_dry_force(0.0, rho, lambda, x);
+            assert_eq!(d.state, ContactState::Slide);
+            assert_eq!((d.force[0], d.force[1]), (0.0, 0.0));
+            let h = 1e-9;
+            for k in 0..3 {
+                let (mut xp, mut xm) = (x, x);
+                xp[k] += h;
+                xm[k] -= h;
+                let fp = augmented_dry_force(0.0, rho, lambda, xp).force;
+                let fm = augmented_dry_force(0.0, rho, lambda, xm).force;
+                for i in 0..3 {
+                    let fd = -(fp[i] - fm[i]) / (2.0 * h);
+                    assert!((d.stiffness[(i, k)] - fd).abs() <= 1e-6 * rho, "{i}{k}: {d:?}");
+                }
+            }
+        }
+    }
+
     use super::*;
     use crate::contact::cone::ContactState;
     use crate::contact::history::LawPointHistory;

@@ -19,6 +19,7 @@
 //! last direction, as GMRES's preconditioner, left a relative residual of 10⁻³ to 1 after
 //! 20 iterations in most directions, where a new one reaches 10⁻⁶ in 2 to 8 (docs/scaling.md).
 
+use crate::linalg::KrylovLimits;
 use crate::problem::NewtonMethod;
 
 /// Largest contraction ‖G − Hᵀr‖ₖ / ‖G − Hᵀr‖ₖ₋₁ of the Newton loop for which its kept
@@ -45,6 +46,30 @@ pub fn keep_for_correction(
     method == NewtonMethod::Modified
         && factor_key == Some(key)
         && last_norm.is_none_or(|last| norm <= NEWTON_CONTRACTION * last)
+}
+
+/// When GMRES stops on a correction under `time.newton = "preconditioned"`: at 10⁻⁶ of the
+/// out-of-balance force it is given (well below the factor 4 per iteration that modified
+/// Newton accepts, so the Newton iterations keep their rate), or after 40 iterations, when K̄
+/// is factorised afresh instead.
+pub const KRYLOV_CORRECTION: KrylovLimits = KrylovLimits {
+    tol: 1e-6,
+    max_iter: 40,
+    restart: 40,
+};
+
+/// GMRES iterations of a correction above which the next correction factorises K̄ afresh:
+/// the kept factor has drifted from K̄ (large strains, contact cases changed) and each
+/// further iteration costs two triangular solves and a product with K̄.
+pub const KRYLOV_REFRESH: usize = 12;
+
+/// Whether a preconditioned correction may use the factorisation in use: one the Newton loop
+/// made (`factor_key` is Some; the semismooth solve's factorisations, with its contact
+/// blocks, are not kept) and not flagged for a `refresh`. Unlike [`keep_for_correction`],
+/// neither Δt nor the contact cases need to match: GMRES solves with the iterate's own K̄, and
+/// a factor that no longer fits shows as GMRES failing or slowing down.
+pub fn keep_as_preconditioner(factor_key: Option<u64>, refresh: bool) -> bool {
+    factor_key.is_some() && !refresh
 }
 
 /// The key of what K̄ is built from besides the iterate: the step size `dt` [s] (K̄'s mass

@@ -4,7 +4,9 @@
 use super::attempt::{Attempt, PhaseTimes};
 use super::constraints::Constraints;
 use super::coupling::{ContactCoupling, Evaluated, Iterate};
-use super::factor_reuse::{keep_for_correction, matrix_key};
+use super::factor_reuse::{
+    keep_as_preconditioner, keep_for_correction, matrix_key, KRYLOV_CORRECTION, KRYLOV_REFRESH,
+};
 use super::integrator::{norm, ThetaStep, Workspace};
 use crate::assembly::{Assembled, Discretisation};
 use crate::problem::{NewtonMethod, TimeSettings};
@@ -43,6 +45,9 @@ pub struct NewtonLoop<'a> {
     method: NewtonMethod,
     /// ‖G − Hᵀr‖ of the last corrected iterate [N] (the contraction test of a kept factor).
     last_norm: Option<f64>,
+    /// Whether the next preconditioned correction factorises K̄ afresh (the last one needed
+    /// many GMRES iterations).
+    refresh: bool,
     /// K̄'s factorisations when the attempt started.
     factorisations0: usize,
     negligible: bool,
@@ -77,6 +82,7 @@ impl<'a> NewtonLoop<'a> {
             timings: PhaseTimes::default(),
             method,
             last_norm: None,
+            refresh: false,
             negligible: false,
             last_relative: f64::NAN,
             contact_residual: 0.0,
@@ -165,19 +171,55 @@ impl<'a> NewtonLoop<'a> {
         let clock = Instant::now();
         let key = matrix_key(self.step.dt, self.coupling.tangent_key());
         let (factor, last) = (self.system.factor_key(), self.last_norm);
-        if !keep_for_correction(self.method, factor, key, last, norm) {
-            self.system.set_from_base(&self.step.matrix_terms(tangent));
-            self.coupling.add_tangent(self.system);
-            self.system
-                .factorise_keyed(key)
-                .map_err(|e| format!("{e} (Newton iteration {iter})"))?;
-        }
-        self.last_norm = Some(norm);
         let force = self.coupling.contact_force();
         let mut du: Vec<f64> = force.iter().zip(&self.ws.g).map(|(r, g)| r - g).collect();
-        self.system.solve_in_place(&mut du);
+        if self.method == NewtonMethod::Preconditioned {
+            self.preconditioned_correction(tangent, key, iter, &mut du)?;
+        } else {
+            if !keep_for_correction(self.method, factor, key, last, norm) {
+                self.system.set_from_base(&self.step.matrix_terms(tangent));
+                self.coupling.add_tangent(self.system);
+                self.system
+                    .factorise_keyed(key)
+                    .map_err(|e| format!("{e} (Newton iteration {iter})"))?;
+            }
+            self.system.solve_in_place(&mut du);
+        }
+        self.last_norm = Some(norm);
         self.timings.factorisation += clock.elapsed().as_secs_f64();
         Ok(du)
+    }
+
+    /// The correction `du` (given as its right-hand side Hᵀr − G) solved with K̄ of this
+    /// iterate by GMRES preconditioned with the kept factorisation ([`keep_as_preconditioner`]);
+    /// K̄ is factorised again, under `key`, when there is none or GMRES does not reach
+    /// [`KRYLOV_CORRECTION`]'s tolerance, and flagged for a new factorisation at the next
+    /// correction when it needed more than [`KRYLOV_REFRESH`] iterations.
+    fn preconditioned_correction(
+        &mut self,
+        tangent: &[f64],
+        key: u64,
+        iter: usize,
+        du: &mut [f64],
+    ) -> Result<(), String> {
+        self.system.set_from_base(&self.step.matrix_terms(tangent));
+        self.coupling.add_tangent(self.system);
+        self.system.apply_conditions();
+        if keep_as_preconditioner(self.system.factor_key(), self.refresh) {
+            let rhs = du.to_vec();
+            let outcome = self.system.solve_preconditioned(du, KRYLOV_CORRECTION);
+            if outcome.relative_residual <= KRYLOV_CORRECTION.tol {
+                self.refresh = outcome.iterations > KRYLOV_REFRESH;
+                return Ok(());
+            }
+            du.copy_from_slice(&rhs);
+        }
+        self.system
+            .factorise_keyed(key)
+            .map_err(|e| format!("{e} (Newton iteration {iter})"))?;
+        self.refresh = false;
+        self.system.solve_in_place(du);
+        Ok(())
     }
 
     /// K̄'s values, with the conditions applied but not factorised, and the out-of-balance
