@@ -4,6 +4,8 @@ the meshes adhesim builds for the same scenario files.
 
   feb.py pad --n 9 --mu 0 OUT.feb             problem 1: bench/febio/pad.toml
   feb.py blocks --n 9 --m 8 --mu 0.3 OUT.feb  problem 2: bench/febio/blocks.toml
+  feb.py hertz --msh MESH.msh --mu 0 --depth 2e-6 --increments 2 OUT.feb
+                                              problem 3: bench/febio/hertz.toml
 
 The pad: a box [0, width] x [0, height] x [0, width] [m] cut into n x layers x n hex8
 elements (adhesim's `block` generator: the node coordinates are the same numbers), FEBio's
@@ -22,6 +24,7 @@ and time step), the same quantity as adhesim's `pad.top.Fy` column of history.cs
 
 import argparse
 import sys
+from pathlib import Path
 
 
 def block_mesh(n, layers, size, offset=(0.0, 0.0, 0.0), first=1):
@@ -197,6 +200,102 @@ def deck(a, mesh, domains, boundary, interaction):
             'file="top_reaction.txt" delim=","/></logfile></Output>\n</febio_spec>\n')
 
 
+def read_msh(path):
+    """Nodes {tag: (x, y, z)}, and per element type the elements [(physical tags, node
+    tags)] of a Gmsh 4.1 ASCII file (what adhesim reads as ASCII)."""
+    lines = iter(Path(path).read_text().split("\n"))
+    physical = {}   # (dim, entity tag) -> [physical tags]
+    nodes, elements = {}, {}
+    for line in lines:
+        if line == "$Entities":
+            counts = [int(c) for c in next(lines).split()]
+            for dim, count in enumerate(counts):
+                for _ in range(count):
+                    f = next(lines).split()
+                    at = 4 if dim == 0 else 7
+                    physical[(dim, int(f[0]))] = [int(t) for t in f[at + 1:at + 1 + int(f[at])]]
+        elif line == "$Nodes":
+            blocks = int(next(lines).split()[0])
+            for _ in range(blocks):
+                _, _, _, count = (int(c) for c in next(lines).split())
+                tags = [int(next(lines)) for _ in range(count)]
+                for tag in tags:
+                    nodes[tag] = tuple(float(c) for c in next(lines).split())
+        elif line == "$Elements":
+            blocks = int(next(lines).split()[0])
+            for _ in range(blocks):
+                dim, entity, kind, count = (int(c) for c in next(lines).split())
+                tags = physical.get((dim, entity), [])
+                rows = elements.setdefault(kind, [])
+                for _ in range(count):
+                    rows.append((tags, [int(c) for c in next(lines).split()[1:]]))
+    return nodes, elements
+
+
+def physical_names(path):
+    """{name: (dim, tag)} of a Gmsh file's $PhysicalNames."""
+    text = Path(path).read_text()
+    block = text.split("$PhysicalNames\n", 1)[1].split("$EndPhysicalNames", 1)[0]
+    names = {}
+    for row in block.strip().split("\n")[1:]:
+        dim, tag, name = row.split(maxsplit=2)
+        names[name.strip('"')] = (int(dim), int(tag))
+    return names
+
+
+def outward(tri, tets_by_face, coords):
+    """`tri` (three node ids) ordered so that its normal points out of the tetrahedron it
+    bounds."""
+    tet = tets_by_face[tuple(sorted(tri))]
+    (opposite,) = set(tet) - set(tri)
+    a, b, c, o = (coords[i] for i in (*tri, opposite))
+    ab = [b[k] - a[k] for k in range(3)]
+    ac = [c[k] - a[k] for k in range(3)]
+    n = [ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2],
+         ab[0] * ac[1] - ab[1] * ac[0]]
+    ao = [o[k] - a[k] for k in range(3)]
+    return tri if sum(n[k] * ao[k] for k in range(3)) < 0.0 else [tri[0], tri[2], tri[1]]
+
+
+def hertz_deck(a):
+    """Problem 3: the quarter hemisphere of a Gmsh tet4 mesh (physical surfaces top, sym_x,
+    sym_z, curved; lengths in mm, scaled by 1e-3) pressed by its top onto the rigid plane
+    y = 0, frictionless (rigid_wall)."""
+    raw_nodes, elements = read_msh(a.msh)
+    names = physical_names(a.msh)
+    ids = {tag: i + 1 for i, tag in enumerate(sorted(raw_nodes))}
+    coords = {ids[t]: tuple(1e-3 * c for c in xyz) for t, xyz in raw_nodes.items()}
+    tets = [[ids[t] for t in nodes] for _, nodes in elements[4]]
+    tets_by_face = {tuple(sorted(f)): tet for tet in tets
+                    for f in ([tet[0], tet[1], tet[2]], [tet[0], tet[1], tet[3]],
+                              [tet[0], tet[2], tet[3]], [tet[1], tet[2], tet[3]])}
+
+    def faces(name):
+        tag = names[name][1]
+        return [outward([ids[t] for t in nodes], tets_by_face, coords)
+                for tags, nodes in elements[2] if tag in tags]
+
+    def node_set(name):
+        return sorted({i for f in faces(name) for i in f})
+
+    rows = "".join(f'<node id="{i}">{num(x)},{num(y)},{num(z)}</node>\n'
+                   for i, (x, y, z) in sorted(coords.items()))
+    mesh = f'<Nodes name="cap">\n{rows}</Nodes>\n<Elements type="tet4" name="cap">\n'
+    mesh += "".join(f'<elem id="{i + 1}">{",".join(map(str, t))}</elem>\n'
+                    for i, t in enumerate(tets)) + "</Elements>\n"
+    mesh += "".join(f'<tri3 id="{i + 1}">{",".join(map(str, f))}</tri3>\n'
+                    for i, f in enumerate(faces("curved"))).join(
+                        ['<Surface name="bottom">\n', '</Surface>\n'])
+    for name in ("top", "sym_x", "sym_z"):
+        mesh += xml_node_set(name, node_set(name))
+    boundary = push_top(a.depth)
+    boundary += ('<bc name="sym_x" node_set="sym_x" type="zero displacement"><x_dof>1</x_dof>'
+                 '<y_dof>0</y_dof><z_dof>0</z_dof></bc><bc name="sym_z" node_set="sym_z" '
+                 'type="zero displacement"><x_dof>0</x_dof><y_dof>0</y_dof><z_dof>1</z_dof></bc>')
+    return deck(a, mesh, '<SolidDomain name="cap" mat="rubber"/>', boundary,
+                frictionless_wall())
+
+
 def common_arguments(p, n):
     p.add_argument("--n", type=int, default=n)
     p.add_argument("--layers", type=int, default=4)
@@ -219,9 +318,13 @@ def main(argv=None):
     common_arguments(blocks, 9)
     blocks.add_argument("--m", type=int, default=8)
     blocks.add_argument("out")
+    hertz = sub.add_parser("hertz", help="problem 3: bench/febio/hertz.toml")
+    common_arguments(hertz, 0)
+    hertz.add_argument("--msh", required=True)
+    hertz.add_argument("out")
     a = p.parse_args(argv)
     with open(a.out, "w") as f:
-        f.write(pad_deck(a) if a.problem == "pad" else blocks_deck(a))
+        f.write({"pad": pad_deck, "blocks": blocks_deck, "hertz": hertz_deck}[a.problem](a))
     return 0
 
 

@@ -44,13 +44,29 @@ def git_commit():
     return r.stdout.strip()
 
 
+# The history.csv column of the force on the pushed top face, per problem.
+TOP_FORCE = {"pad": "pad.top.Fy", "blocks": "pad.top.Fy", "hertz": "cap.top.Fy"}
+
 # Base elements per side for the pad's n in problem 2 (faces about 1.3 times the pad's).
 BASE_DIVISIONS = {9: 8, 31: 29, 99: 91}
 
 
+# Problem 3's mesh (one size) and its load, as bench/febio/hertz.toml has them.
+HERTZ_MESH = ROOT / "crates/adhesim/tests/data/hertz-hemisphere-tet4.msh"
+HERTZ_LOAD = ["--depth", "2e-6", "--increments", "2"]
+
+
 def sizes(problem, n):
     """The size parameters of `problem` at the pad's `n`: [(name, value)]."""
+    if problem == "hertz":
+        return []
     return [("n", n)] + ([("m", BASE_DIVISIONS[n])] if problem == "blocks" else [])
+
+
+def hertz_quarter_force(young=2.6e6, poisson=0.3, radius=5e-3, depth=2e-6):
+    """Hertz's force [N] on the quarter sphere of problem 3: 4/3 E* sqrt(R) d^(3/2) / 4."""
+    e_star = young / (1.0 - poisson ** 2)
+    return e_star * radius ** 0.5 * depth ** 1.5 / 3.0
 
 
 def adhesim_run(a, problem, n, mu, work):
@@ -70,7 +86,7 @@ def adhesim_run(a, problem, n, mu, work):
             "rss_kb": rss, "steps": len(rows),
             "newton": int(sum(r["newton_iterations"] for r in rows)),
             "factorisations": int(sum(r["factorisations"] for r in rows)),
-            "phases": phases, "forces": [[r["t"], r["pad.top.Fy"]] for r in rows]}
+            "phases": phases, "forces": [[r["t"], r[TOP_FORCE[problem]]] for r in rows]}
 
 
 def febio_log_totals(path):
@@ -113,6 +129,8 @@ def febio_run(a, problem, n, mu, work):
     deck = work / f"febio-{problem}-n{n}-mu{mu}" / "pad.feb"
     deck.parent.mkdir(parents=True, exist_ok=True)
     size_args = [arg for k, v in sizes(problem, n) for arg in (f"--{k}", str(v))]
+    if problem == "hertz":
+        size_args += ["--msh", str(HERTZ_MESH)] + HERTZ_LOAD
     subprocess.run([sys.executable, str(HERE / "feb.py"), problem] + size_args
                    + ["--mu", str(mu), str(deck)], check=True)
     for stale in ("pad.log", "top_reaction.txt", "pad.xplt"):
@@ -133,7 +151,7 @@ def run_all(a):
     work = Path(a.work)
     work.mkdir(parents=True, exist_ok=True)
     for problem in a.problems:
-        for n in a.sizes:
+        for n in (a.sizes if problem != "hertz" else [0]):
             for mu in a.mus:
                 for rep in range(a.reps):
                     run_pair(a, problem, n, mu, rep, work)
@@ -171,6 +189,11 @@ def pair_ratios(records, key):
             if "adhesim" in p and "febio" in p and p["febio"][key]]
 
 
+def contact_nodes(problem, n):
+    """The pad's contact nodes, (n + 1)², or the mesh's name for problem 3."""
+    return "tet4 mesh" if problem == "hertz" else f"{(n + 1) ** 2:,}"
+
+
 def force_difference(adh, feb):
     """Largest ||F_adhesim| − |F_FEBio|| / |F_FEBio| over the times both report (each code
     gives the reaction at the pad's top with its own sign convention)."""
@@ -204,13 +227,21 @@ def report(a):
         walls, cpus = pair_ratios(rs, "wall"), pair_ratios(rs, "cpu")
         la, lf = adh[-1], feb[-1]
         lines.append(
-            f"| {problem} | {settings or 'defaults'} | {(n + 1) ** 2:,} | {mu:g} | {len(walls)} | {med(adh, 'wall'):.2f} s | "
+            f"| {problem} | {settings or 'defaults'} | {contact_nodes(problem, n)} | {mu:g} | {len(walls)} | {med(adh, 'wall'):.2f} s | "
             f"{med(feb, 'wall'):.2f} s | {statistics.median(walls):.2f} | "
             f"{statistics.median(cpus):.2f} | {med(adh, 'rss_kb') / 1e6:.2f} GB | "
             f"{med(feb, 'rss_kb') / 1e6:.2f} GB | {la['newton']} / {la['factorisations']} | "
             f"{lf.get('newton')} / {lf.get('factorisations')} | {la['forces'][-1][1]:.5g} N, "
             f"{lf['forces'][-1][1]:.5g} N | "
             f"{100 * force_difference(la['forces'], lf['forces']):.2f} % |")
+    hertz = [r for r in records if r.get("problem") == "hertz" and "forces" in r]
+    if hertz:
+        closed = hertz_quarter_force()
+        lines += ["", f"Problem 3 against Hertz's force on the quarter sphere, {closed:.5g} N "
+                  f"(4/3 E* √R d^(3/2) / 4): " + ", ".join(
+                      f"{tool} {abs(rs[-1]['forces'][-1][1]) / closed:.4f}"
+                      for tool in ("adhesim", "febio")
+                      for rs in [[r for r in hertz if r["tool"] == tool]] if rs) + " of it."]
     Path(a.report).write_text("\n".join(lines) + "\n")
     print(Path(a.report).read_text())
 
@@ -219,7 +250,7 @@ def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--febio", default=os.environ.get("FEBIO"))
     p.add_argument("--adhesim", default=str(ROOT / "target" / "release" / "adhesim"))
-    p.add_argument("--problems", default="pad,blocks")
+    p.add_argument("--problems", default="pad,blocks,hertz")
     p.add_argument("--sizes", default="9,31,99")
     p.add_argument("--mus", default="0,0.3")
     p.add_argument("--reps", type=int, default=3)
