@@ -3,7 +3,7 @@
 //!
 //! Usage: fclib-bench [--tol T] [--runs N] [--max-iter N] [--solvers a,b,...] FILE...
 //!
-//! Solvers: `nsgs-dense` (the stepper's Gauss-Seidel on a dense W, `contact::solve`),
+//! Solvers: `nsgs-dense` (the stepper's Gauss-Seidel on a dense W, `contact::solver::gauss_seidel`),
 //! `nsgs-blocks` (Gauss-Seidel on W in 3×3 sparse blocks), `newton` (semismooth Newton),
 //! `newton-prox` (proximal-point iterations of semismooth Newton), and for global problems
 //! only, timed from M and H on: `global-newton` (semismooth Newton on (v, r) with M and H,
@@ -21,9 +21,9 @@ use std::time::Instant;
 use adhesim::contact::detect::ContactPoint;
 use adhesim::contact::history::PointHistory;
 use adhesim::contact::law::InterfaceLaw;
-use adhesim::contact::reduced::{error_of, gauss_seidel_blocks, ReducedSolution};
-use adhesim::contact::semismooth::{proximal_newton, semismooth_newton};
-use adhesim::contact::solve::{gauss_seidel, Delassus};
+use adhesim::contact::solver::gauss_seidel::delassus::{gauss_seidel, Delassus};
+use adhesim::contact::solver::reduced::{error_of, gauss_seidel_blocks, ReducedSolution};
+use adhesim::contact::solver::semismooth::reduced::{proximal_newton, semismooth_newton};
 use adhesim_fclib::{read, solve_global, Problem, ReducedProblem};
 
 const SOLVERS: [&str; 6] = [
@@ -112,7 +112,7 @@ fn parse_args() -> Result<Options, String> {
     Ok(o)
 }
 
-/// Gauss-Seidel of the stepper (`contact::solve::gauss_seidel`) on a dense W, one sweep per
+/// Gauss-Seidel of the stepper (`contact::solver::gauss_seidel::delassus::gauss_seidel`) on a dense W, one sweep per
 /// call so that Siconos's error can be checked after each sweep (the warm start carries r).
 fn nsgs_dense(p: &ReducedProblem, del: &Delassus, tol: f64, max_iter: usize) -> ReducedSolution {
     let n = p.w.points();

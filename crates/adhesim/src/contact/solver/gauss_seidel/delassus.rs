@@ -2,11 +2,11 @@
 //! W = H K̄⁻¹ Hᵀ from one multi-right-hand-side solve with the iteration's factorisation, and
 //! a nonlinear Gauss-Seidel sweep over contact points with the local bi-potential/RCC solve.
 
-use super::detect::ContactPoint;
-use super::history::PointHistory;
-use super::interface::PointSolution;
-use super::law::InterfaceLaw;
 use super::point::{default_rho, solve_point, PointProblem};
+use crate::contact::detect::ContactPoint;
+use crate::contact::history::PointHistory;
+use crate::contact::interface::PointSolution;
+use crate::contact::law::InterfaceLaw;
 use crate::linalg::LinearSolve;
 use crate::{mat3_from_rows, Mat3};
 

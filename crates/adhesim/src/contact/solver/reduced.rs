@@ -4,15 +4,15 @@
 //!
 //! W is stored in 3×3 blocks, one per pair of contact points that interact, rows by point
 //! ([`BlockSparseDelassus`]); components are ordered (t1, t2, n) with `r_n > 0` compression and
-//! `x_n ≥ 0` apart, as in [`super::law`]. [`gauss_seidel_blocks`] is the nonlinear Gauss–Seidel
-//! sweep of [`super::solve`] on this storage, point by point with [`solve_point`]; the
-//! semismooth Newton method is in [`super::semismooth`]. Both stop on Siconos's relative error
+//! `x_n ≥ 0` apart, as in [`crate::contact::law`]. [`gauss_seidel_blocks`] is the nonlinear Gauss–Seidel
+//! sweep of [`super::gauss_seidel::delassus`] on this storage, point by point with [`solve_point`]; the
+//! semismooth Newton method is in [`super::semismooth::reduced`]. Both stop on Siconos's relative error
 //! ([`relative_error`] of [`natural_map_residual`]).
 
-use super::history::PointHistory;
-use super::law::InterfaceLaw;
+use super::gauss_seidel::point::{default_rho, solve_point, PointProblem};
 use super::natural_map::{natural_map_residual, relative_error};
-use super::point::{default_rho, solve_point, PointProblem};
+use crate::contact::history::PointHistory;
+use crate::contact::law::InterfaceLaw;
 use crate::mat3_from_rows;
 
 type M3 = [[f64; 3]; 3];

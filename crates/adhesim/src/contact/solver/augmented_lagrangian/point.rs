@@ -18,12 +18,12 @@
 //!
 //! Everything here is pure: the stepper owns the loop.
 
-use super::anisotropic::{scale, scale_matrix, unscale};
-use super::cone::{bipotential_trial, dry_projection, ContactState};
-use super::detect::ContactPoint;
-use super::history::PointHistory;
-use super::interface::{Interface, PointSolution};
-use super::law::InterfaceLaw;
+use crate::contact::anisotropic::{scale, scale_matrix, unscale};
+use crate::contact::cone::{bipotential_trial, dry_projection, ContactState};
+use crate::contact::detect::ContactPoint;
+use crate::contact::history::PointHistory;
+use crate::contact::interface::{Interface, PointSolution};
+use crate::contact::law::InterfaceLaw;
 use crate::system::SystemMatrix;
 use crate::{Mat3, Vec3};
 
