@@ -10,7 +10,7 @@ use crate::contact::detect::ContactPoint;
 use crate::contact::history::PointHistory;
 use crate::contact::interface::PointSolution;
 use crate::contact::law::natural_map_defect;
-use crate::contact::solver::augmented_lagrangian::point as newton;
+use crate::contact::solver::site_stiffness::{point_stiffness, RHO_FACTOR};
 use crate::contact::InterfaceLaw;
 use crate::system::SystemMatrix;
 
@@ -88,7 +88,7 @@ impl StepContact<'_> {
         self.points.is_empty()
     }
 
-    /// Sets ρ_α to [`newton::RHO_FACTOR`] times the stiffness K̄ shows at each point, from
+    /// Sets ρ_α to [`RHO_FACTOR`] times the stiffness K̄ shows at each point, from
     /// K̄'s diagonal (computed only when there are candidates).
     pub fn set_augmentation(&mut self, diagonal: impl FnOnce() -> Vec<f64>) {
         if self.is_empty() {
@@ -99,8 +99,8 @@ impl StepContact<'_> {
             .points
             .iter()
             .map(|pt| {
-                newton::point_stiffness(pt, &diagonal, self.constraints.mask())
-                    .map_or(1.0, |k| newton::RHO_FACTOR * k)
+                point_stiffness(pt, &diagonal, self.constraints.mask())
+                    .map_or(1.0, |k| RHO_FACTOR * k)
             })
             .collect();
     }

@@ -9,12 +9,14 @@
 //! - [`semismooth`]: the W-free semismooth solve on the mixed system (the default above 200
 //!   candidate sites).
 //!
-//! Shared by them: [`reduced`], the reduced dry problem x = q + W r without a mesh, as the
-//! fclib benchmarks pose it (Gauss-Seidel and semismooth Newton solve it), and
-//! [`natural_map`], its error measure.
+//! Shared by them: [`site_stiffness`], the stiffness K̄ shows at a site (which sets ρ_α) and
+//! what the solves that put the contact conditions into K̄ add to it; [`reduced`], the reduced
+//! dry problem x = q + W r without a mesh, as the fclib benchmarks pose it (Gauss-Seidel and
+//! semismooth Newton solve it), and [`natural_map`], its error measure.
 
 pub mod augmented_lagrangian;
 pub mod gauss_seidel;
 pub mod natural_map;
 pub mod reduced;
 pub mod semismooth;
+pub mod site_stiffness;

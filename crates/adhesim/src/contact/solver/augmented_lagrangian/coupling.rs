@@ -6,6 +6,7 @@
 use super::point::{self, augmented_point, AugmentedPoint};
 use crate::contact::cone::ContactState;
 use crate::contact::interface::PointSolution;
+use crate::contact::solver::site_stiffness::{add_contact_tangent, couplings};
 use crate::rows_of;
 use crate::system::SystemMatrix;
 use crate::time::coupling::{ContactCoupling, Evaluated, Iterate, PhaseTimes, StepContact};
@@ -54,7 +55,7 @@ impl<'a> NewtonCoupling<'a> {
     ) -> Result<Self, String> {
         if !sc.is_empty() {
             system
-                .ensure_couplings(&point::couplings(&sc.points))
+                .ensure_couplings(&couplings(&sc.points))
                 .map_err(|e| e.to_string())?;
         }
         let n = sc.constraints.mask().len();
@@ -172,7 +173,7 @@ impl<'a> ContactCoupling<'a> for NewtonCoupling<'a> {
             return;
         }
         let stiffness: Vec<_> = self.evals.iter().map(|e| rows_of(&e.stiffness)).collect();
-        point::add_contact_tangent(&self.sc.points, &stiffness, system);
+        add_contact_tangent(&self.sc.points, &stiffness, system);
     }
 
     fn tangent_key(&self) -> u64 {

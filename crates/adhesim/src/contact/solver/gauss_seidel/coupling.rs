@@ -3,7 +3,8 @@
 //! solved point by point and the correction completed by K̄⁻¹Hᵀ(r − r_prev). W is kept
 //! between steps and reused while it is still accurate.
 
-use super::delassus::{delassus, gauss_seidel, Delassus};
+use super::delassus::{delassus, Delassus};
+use super::sweep::gauss_seidel;
 use crate::contact::detect::ContactPoint;
 use crate::contact::interface::PointSolution;
 use crate::linalg::norm;

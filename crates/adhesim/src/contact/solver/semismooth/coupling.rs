@@ -15,8 +15,7 @@ use super::mixed::{
 };
 use crate::contact::detect::ContactPoint;
 use crate::contact::interface::PointSolution;
-use crate::contact::solver::augmented_lagrangian::point::add_contact_tangent;
-use crate::contact::solver::augmented_lagrangian::point::RHO_FACTOR;
+use crate::contact::solver::site_stiffness::{add_contact_tangent, couplings, RHO_FACTOR};
 use crate::linalg::{gmres_with_remainder, KrylovLimits};
 use crate::system::SystemMatrix;
 use crate::time::coupling::{ContactCoupling, Iterate, PhaseTimes, StepContact};
@@ -68,9 +67,7 @@ impl<'a> MixedCoupling<'a> {
     ) -> Result<Self, String> {
         if !sc.is_empty() {
             system
-                .ensure_couplings(
-                    &crate::contact::solver::augmented_lagrangian::point::couplings(&sc.points),
-                )
+                .ensure_couplings(&couplings(&sc.points))
                 .map_err(|e| e.to_string())?;
         }
         workspace.start_step();

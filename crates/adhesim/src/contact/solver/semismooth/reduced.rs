@@ -42,12 +42,11 @@ use crate::linalg::faer_call;
 use crate::contact::cone::{
     bipotential_trial, dry_projection, modified_displacement_jacobian, projection_jacobian,
 };
+use crate::contact::solver::gauss_seidel::reduced::{gauss_seidel_sweep, point_rhos};
 use crate::contact::solver::natural_map::{
     natural_map_point, natural_map_residual, relative_error,
 };
-use crate::contact::solver::reduced::{
-    gauss_seidel_sweep, point_rhos, BlockSparseDelassus, ReducedSolution,
-};
+use crate::contact::solver::reduced::{BlockSparseDelassus, ReducedSolution};
 
 type M3 = [[f64; 3]; 3];
 
@@ -408,7 +407,7 @@ const PROX_INNER: usize = 50;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::solver::reduced::gauss_seidel_blocks;
+    use crate::contact::solver::gauss_seidel::reduced::gauss_seidel_blocks;
     use crate::contact::solver::reduced::test_support::{random_spd, Lcg};
 
     fn problem(n: usize, seed: u64) -> (BlockSparseDelassus, Vec<[f64; 3]>) {
