@@ -16,7 +16,7 @@
 
 use std::path::{Path, PathBuf};
 
-use adhesim::contact::reduced::{BlockSparseDelassus, ReducedSolution};
+use adhesim::contact::solver::reduced::{BlockSparseDelassus, ReducedSolution};
 use nalgebra::DMatrix;
 
 /// A failure to read an fclib file: the file, the dataset and what went wrong.
@@ -642,8 +642,8 @@ fn diagonal_blocks(m: &SparseMatrix) -> Vec<DiagonalBlock> {
 }
 
 /// Solves a global problem without condensing it: the semismooth Newton method of
-/// `adhesim::contact::mixed` on the mixed system in (v, r), with M in place of K̄ and fclib's H
-/// (each contact reads u = H_αᵀ v + w_α). W = Hᵀ M⁻¹ H is never formed; each Newton step
+/// `adhesim::contact::solver::semismooth::mixed` on the mixed system in (v, r), with M in place
+/// of K̄ and fclib's H (each contact reads u = H_αᵀ v + w_α). W = Hᵀ M⁻¹ H is never formed; each Newton step
 /// factorises the sparse mixed matrix (unknowns plus three rows per contact) by LU, and one more
 /// sparse LU of M gives the start q = Hᵀ M⁻¹ f + w. ρ_α = 3/λ_max of Σ_i h_i h_iᵀ/M_ii (W_αα
 /// exactly when M is diagonal). Stops on Siconos's error ≤ `tol` or after `max_iter` steps.
@@ -657,8 +657,10 @@ pub fn solve_global(
     use adhesim::contact::history::PointHistory;
     use adhesim::contact::interface::PointSolution;
     use adhesim::contact::law::InterfaceLaw;
-    use adhesim::contact::mixed::{linearise_point, solve_mixed, LuDirection, MixedOperator};
-    use adhesim::contact::natural_map::{natural_map_residual, relative_error};
+    use adhesim::contact::solver::natural_map::{natural_map_residual, relative_error};
+    use adhesim::contact::solver::semismooth::mixed::{
+        linearise_point, solve_mixed, LuDirection, MixedOperator,
+    };
     use std::collections::BTreeMap;
 
     let n = p.m.rows;

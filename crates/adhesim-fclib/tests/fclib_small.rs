@@ -2,9 +2,9 @@
 //! contact solvers. Reference values were read independently with h5py/numpy from the same
 //! files (numpy condensed W = Hᵀ M⁻¹ H with a dense solve).
 
-use adhesim::contact::natural_map::{natural_map_residual, relative_error};
-use adhesim::contact::reduced::gauss_seidel_blocks;
-use adhesim::contact::semismooth::semismooth_newton;
+use adhesim::contact::solver::gauss_seidel::reduced::gauss_seidel_blocks;
+use adhesim::contact::solver::natural_map::{natural_map_residual, relative_error};
+use adhesim::contact::solver::semismooth::reduced::semismooth_newton;
 use adhesim_fclib::{read, ReducedProblem, Storage};
 
 fn data(name: &str) -> String {

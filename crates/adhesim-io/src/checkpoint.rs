@@ -446,7 +446,7 @@ mod tests {
                 delassus: Some(CachedDelassus {
                     key: vec![7, u64::MAX],
                     frames: vec![[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -0.5]]],
-                    w: adhesim::contact::solve::Delassus {
+                    w: adhesim::contact::solver::gauss_seidel::delassus::Delassus {
                         w: (0..9).map(|i| i as f64 * 1e-7).collect(),
                         m: 3,
                     },

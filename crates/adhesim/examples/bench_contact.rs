@@ -28,7 +28,8 @@
 use adhesim::contact::detect::ContactPoint;
 use adhesim::contact::discretisation::detect;
 use adhesim::contact::history::PointHistory;
-use adhesim::contact::solve::{delassus, gauss_seidel, Delassus};
+use adhesim::contact::solver::gauss_seidel::delassus::{delassus, Delassus};
+use adhesim::contact::solver::gauss_seidel::sweep::gauss_seidel;
 use adhesim::linalg::SparseCholesky;
 use adhesim::problem::Problem;
 use adhesim::time::{StepReport, Stepper};

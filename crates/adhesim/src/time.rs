@@ -9,12 +9,9 @@
 
 mod attempt;
 mod constraints;
-mod coupling;
-mod delassus_coupling;
+pub(crate) mod coupling;
 pub mod factor_reuse;
 mod integrator;
-mod mixed_coupling;
-mod newton_coupling;
 mod newton_loop;
 
 pub use attempt::PhaseTimes;
@@ -27,17 +24,17 @@ use crate::contact::discretisation::detect;
 use crate::contact::history::PointHistory;
 use crate::contact::history::SiteHistory;
 use crate::contact::interface::{Interface, PointSolution};
-use crate::contact::mixed::MixedWorkspace;
+use crate::contact::solver::augmented_lagrangian::coupling::NewtonCoupling;
+use crate::contact::solver::gauss_seidel::coupling::DelassusCoupling;
+pub use crate::contact::solver::gauss_seidel::{CachedDelassus, DelassusCache};
+use crate::contact::solver::semismooth::coupling::MixedCoupling;
+use crate::contact::solver::semismooth::mixed::MixedWorkspace;
 use crate::linalg::LinalgError;
 use crate::problem::{ContactSolver, NewtonMethod, Problem};
 use crate::system::SystemMatrix;
 use attempt::Attempt;
 use coupling::{Candidates, ContactCoupling, StepContact};
-use delassus_coupling::DelassusCoupling;
-pub use delassus_coupling::{CachedDelassus, DelassusCache};
 use integrator::{Inertia, Scheme, ThetaStep, Workspace};
-use mixed_coupling::MixedCoupling;
-use newton_coupling::NewtonCoupling;
 use newton_loop::{Flow, NewtonLoop};
 use std::sync::Arc;
 use std::time::Instant;

@@ -10,9 +10,9 @@
 use adhesim::contact::anisotropic::{sliding_friction, Orthotropy};
 use adhesim::contact::history::{LawPointHistory, PointHistory};
 use adhesim::contact::law::{natural_map_defect, InterfaceLaw};
-use adhesim::contact::newton::augmented_point;
-use adhesim::contact::point::{solve_point, PointProblem};
 use adhesim::contact::rcc::{adhesive_response, BondState, RccParams};
+use adhesim::contact::solver::augmented_lagrangian::point::augmented_point;
+use adhesim::contact::solver::gauss_seidel::point::{solve_point, PointProblem};
 use adhesim::time::Stepper;
 use adhesim::{mat3_from_rows, Mat3, Vec2, Vec3};
 use std::path::Path;

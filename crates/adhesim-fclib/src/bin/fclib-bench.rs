@@ -3,13 +3,13 @@
 //!
 //! Usage: fclib-bench [--tol T] [--runs N] [--max-iter N] [--solvers a,b,...] FILE...
 //!
-//! Solvers: `nsgs-dense` (the stepper's Gauss-Seidel on a dense W, `contact::solve`),
-//! `nsgs-blocks` (Gauss-Seidel on W in 3×3 sparse blocks), `newton` (semismooth Newton),
-//! `newton-prox` (proximal-point iterations of semismooth Newton), and for global problems
-//! only, timed from M and H on: `global-newton` (semismooth Newton on (v, r) with M and H,
-//! never forming W) and `global-condensed` (the condensation W = Hᵀ M⁻¹ H block by block of
-//! M, then `newton`). Newton solvers stop after at most 2000 iterations whatever
-//! `--max-iter` says.
+//! Solvers: `nsgs-dense` (the stepper's Gauss-Seidel on a dense W,
+//! `contact::solver::gauss_seidel::sweep`), `nsgs-blocks` (Gauss-Seidel on W in 3×3 sparse
+//! blocks), `newton` (semismooth Newton), `newton-prox` (proximal-point iterations of
+//! semismooth Newton), and for global problems only, timed from M and H on: `global-newton`
+//! (semismooth Newton on (v, r) with M and H, never forming W) and `global-condensed` (the
+//! condensation W = Hᵀ M⁻¹ H block by block of M, then `newton`). Newton solvers stop after
+//! at most 2000 iterations whatever `--max-iter` says.
 //! For the other solvers global problems are condensed to W = Hᵀ M⁻¹ H first; the
 //! condensation is timed apart (column `condense_ms`) and not included in their times. Every
 //! solver starts from r = 0.
@@ -21,9 +21,11 @@ use std::time::Instant;
 use adhesim::contact::detect::ContactPoint;
 use adhesim::contact::history::PointHistory;
 use adhesim::contact::law::InterfaceLaw;
-use adhesim::contact::reduced::{error_of, gauss_seidel_blocks, ReducedSolution};
-use adhesim::contact::semismooth::{proximal_newton, semismooth_newton};
-use adhesim::contact::solve::{gauss_seidel, Delassus};
+use adhesim::contact::solver::gauss_seidel::delassus::Delassus;
+use adhesim::contact::solver::gauss_seidel::reduced::gauss_seidel_blocks;
+use adhesim::contact::solver::gauss_seidel::sweep::gauss_seidel;
+use adhesim::contact::solver::reduced::{error_of, ReducedSolution};
+use adhesim::contact::solver::semismooth::reduced::{proximal_newton, semismooth_newton};
 use adhesim_fclib::{read, solve_global, Problem, ReducedProblem};
 
 const SOLVERS: [&str; 6] = [
@@ -112,8 +114,9 @@ fn parse_args() -> Result<Options, String> {
     Ok(o)
 }
 
-/// Gauss-Seidel of the stepper (`contact::solve::gauss_seidel`) on a dense W, one sweep per
-/// call so that Siconos's error can be checked after each sweep (the warm start carries r).
+/// Gauss-Seidel of the stepper (`contact::solver::gauss_seidel::sweep::gauss_seidel`) on a dense
+/// W, one sweep per call so that Siconos's error can be checked after each sweep (the warm
+/// start carries r).
 fn nsgs_dense(p: &ReducedProblem, del: &Delassus, tol: f64, max_iter: usize) -> ReducedSolution {
     let n = p.w.points();
     let points: Vec<ContactPoint> = (0..n)

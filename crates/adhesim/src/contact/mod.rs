@@ -16,18 +16,10 @@
 //!   [`rcc`]: the Raous-Cangémi-Cocou law, its parameters, maths and history;
 //!   [`law`]: a pair's law (its cone and its bonds); [`history`]: a law's history at a site,
 //!   with named fields; [`registry`]: the laws the program knows, for what is drawn from a
-//!   history file alone;
-//! - [`point`]: the point solver of the Gauss-Seidel sweep.
+//!   history file alone.
 //!
-//! Solvers (the contact problem of a Newton iteration; the coupling to the step is in
-//! `time/`):
-//! - [`solve`]: the Delassus operator W = H K̄⁻¹ Hᵀ and nonlinear Gauss-Seidel over sites;
-//! - [`mixed`]: the W-free semismooth solve on the mixed system (the default above 200
-//!   candidate sites);
-//! - [`newton`]: the augmented-Lagrangian contact terms inside the step's own Newton loop;
-//! - [`reduced`] and [`semismooth`]: the reduced dry problem x = q + W r without a mesh
-//!   (Gauss-Seidel and semismooth Newton), as the fclib benchmarks pose it;
-//!   [`natural_map`]: its error measure.
+//! Solvers (the contact problem of a Newton iteration): [`solver`], one folder per solver
+//! holding its point-wise maths and its coupling to the step's Newton loop.
 
 pub mod anisotropic;
 pub(crate) mod cone;
@@ -36,18 +28,12 @@ pub mod discretisation;
 pub mod history;
 pub mod interface;
 pub mod law;
-pub mod mixed;
 pub(crate) mod mortar;
-pub mod natural_map;
-pub mod newton;
 pub(crate) mod node_to_surface;
-pub mod point;
 pub mod polygon;
 pub mod rcc;
-pub mod reduced;
 pub mod registry;
-pub mod semismooth;
-pub mod solve;
+pub mod solver;
 #[cfg(test)]
 mod test_support;
 

@@ -1,17 +1,16 @@
-//! The contact stage of a step: the candidates found at its start, and the three ways of
-//! solving the contact conditions inside the Newton loop behind one trait
-//! ([`ContactCoupling`]): Gauss-Seidel on the Delassus operator
-//! ([`super::delassus_coupling`]), the W-free semismooth solve on the mixed system
-//! ([`super::mixed_coupling`]) and the augmented-Lagrangian Newton solve
-//! ([`super::newton_coupling`]). docs/contact-solver.md describes all three.
+//! The contact stage of a step: the candidates found at its start, and the trait
+//! ([`ContactCoupling`]) behind which the Newton loop calls the three ways of solving the
+//! contact conditions, each implemented with its solver in [`crate::contact::solver`]:
+//! Gauss-Seidel on the Delassus operator, the W-free semismooth solve on the mixed system and
+//! the augmented-Lagrangian Newton solve. docs/contact-solver.md describes all three.
 
-use super::attempt::PhaseTimes;
+pub(crate) use super::attempt::PhaseTimes;
 use super::constraints::Constraints;
 use crate::contact::detect::ContactPoint;
 use crate::contact::history::PointHistory;
 use crate::contact::interface::PointSolution;
 use crate::contact::law::natural_map_defect;
-use crate::contact::newton;
+use crate::contact::solver::site_stiffness::{point_stiffness, RHO_FACTOR};
 use crate::contact::InterfaceLaw;
 use crate::system::SystemMatrix;
 
@@ -89,7 +88,7 @@ impl StepContact<'_> {
         self.points.is_empty()
     }
 
-    /// Sets ρ_α to [`newton::RHO_FACTOR`] times the stiffness K̄ shows at each point, from
+    /// Sets ρ_α to [`RHO_FACTOR`] times the stiffness K̄ shows at each point, from
     /// K̄'s diagonal (computed only when there are candidates).
     pub fn set_augmentation(&mut self, diagonal: impl FnOnce() -> Vec<f64>) {
         if self.is_empty() {
@@ -100,8 +99,8 @@ impl StepContact<'_> {
             .points
             .iter()
             .map(|pt| {
-                newton::point_stiffness(pt, &diagonal, self.constraints.mask())
-                    .map_or(1.0, |k| newton::RHO_FACTOR * k)
+                point_stiffness(pt, &diagonal, self.constraints.mask())
+                    .map_or(1.0, |k| RHO_FACTOR * k)
             })
             .collect();
     }

@@ -1,6 +1,6 @@
 //! The point solver of the nonlinear Gauss–Seidel sweep over contact points: the local problem
 //! x = x_free + W_αα (r̄ + r̃) at one point, with the dry force r̄ on Coulomb's cone
-//! (`cone.rs`) and the adhesive force r̃ of the pair's bond law ([`super::interface`]).
+//! (`cone.rs`) and the adhesive force r̃ of the pair's bond law ([`crate::contact::interface`]).
 //! Pure functions on plain arrays: no mesh, no allocation.
 //!
 //! [`solve_point`] solves the apart, stick and slide cases directly (the adhesive part
@@ -9,14 +9,14 @@
 //! fallback. A plain fixed point diverges once C·A·‖W‖ > 1 if r̃ lags one iteration behind x,
 //! and crawls when the compliance is ill-conditioned.
 
-use super::anisotropic::{scale, scale_matrix, unscale, unscale_matrix};
-use super::cone::{
+use crate::contact::anisotropic::{scale, scale_matrix, unscale, unscale_matrix};
+use crate::contact::cone::{
     bipotential_trial, dry_projection, modified_displacement_jacobian, projection_jacobian,
     ContactState,
 };
-use super::history::PointHistory;
-use super::interface::{AdhEval, FrozenSprings, Interface, PointSolution};
-use super::law::InterfaceLaw;
+use crate::contact::history::PointHistory;
+use crate::contact::interface::{AdhEval, FrozenSprings, Interface, PointSolution};
+use crate::contact::law::InterfaceLaw;
 use crate::{Mat3, Vec3};
 use std::f64::consts::PI;
 
@@ -161,7 +161,7 @@ enum Method {
 }
 
 /// [`solve_point`] with a choice of method. An orthotropic law is solved as the isotropic
-/// problem of its scaled variables r' = T⁻¹r, x' = Tx ([`super::anisotropic`]).
+/// problem of its scaled variables r' = T⁻¹r, x' = Tx ([`crate::contact::anisotropic`]).
 fn solve_point_impl(
     p: &PointProblem,
     r_start: Vec3,
@@ -939,7 +939,7 @@ mod tests {
         let adhesion = p
             .law
             .as_any()
-            .downcast_ref::<super::super::rcc::Rcc>()
+            .downcast_ref::<crate::contact::rcc::Rcc>()
             .unwrap()
             .0;
         match &adhesion {

@@ -2,25 +2,23 @@
 //! (docs/contact-solver.md). Each Newton iteration of the step solves the momentum balance
 //! and the contact law together: from the iterate u and the forces r_prev, the linear model
 //! K̄ δu = Hᵀ(r − r_prev) + m (m = Hᵀr_prev − G, the out-of-balance force), x = x(u) + H δu,
-//! with the law Φ(r, x) = 0, is solved by [`crate::contact::mixed::solve_mixed`] without W:
+//! with the law Φ(r, x) = 0, is solved by [`super::mixed::solve_mixed`] without W:
 //! each direction of the mixed (displacement, force) system comes from one sparse Cholesky
 //! factorisation of K̄ with the points' condensed blocks, and GMRES ([`CondensedDirection`]).
 //! The step's matrix is therefore factorised once per direction and never alone. The
 //! factorisations are counted in `time_factorisation`, the rest of the solve (the points'
 //! linearisations, GMRES, the line search) in `time_contact_solve`.
 
-use super::coupling::{ContactCoupling, Iterate, StepContact};
-use super::PhaseTimes;
-use crate::contact::detect::ContactPoint;
-use crate::contact::interface::PointSolution;
-use crate::contact::mixed::{
+use super::mixed::{
     add_ht_terms, apply_h_terms, linearise_point, solve_mixed, Direction, LuDirection,
     MixedDirection, MixedOperator, MixedPattern, MixedWorkspace, PointLinearisation,
 };
-use crate::contact::newton::add_contact_tangent;
-use crate::contact::newton::RHO_FACTOR;
+use crate::contact::detect::ContactPoint;
+use crate::contact::interface::PointSolution;
+use crate::contact::solver::site_stiffness::{add_contact_tangent, couplings, RHO_FACTOR};
 use crate::linalg::{gmres_with_remainder, KrylovLimits};
 use crate::system::SystemMatrix;
+use crate::time::coupling::{ContactCoupling, Iterate, PhaseTimes, StepContact};
 use crate::{rows_of, Mat3};
 use std::time::Instant;
 
@@ -69,7 +67,7 @@ impl<'a> MixedCoupling<'a> {
     ) -> Result<Self, String> {
         if !sc.is_empty() {
             system
-                .ensure_couplings(&crate::contact::newton::couplings(&sc.points))
+                .ensure_couplings(&couplings(&sc.points))
                 .map_err(|e| e.to_string())?;
         }
         workspace.start_step();

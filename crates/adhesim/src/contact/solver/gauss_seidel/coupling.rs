@@ -3,13 +3,13 @@
 //! solved point by point and the correction completed by K̄⁻¹Hᵀ(r − r_prev). W is kept
 //! between steps and reused while it is still accurate.
 
-use super::coupling::{ContactCoupling, Iterate, StepContact};
-use super::integrator::norm;
-use super::PhaseTimes;
+use super::delassus::{delassus, Delassus};
+use super::sweep::gauss_seidel;
 use crate::contact::detect::ContactPoint;
 use crate::contact::interface::PointSolution;
-use crate::contact::solve::{delassus, gauss_seidel, Delassus};
+use crate::linalg::norm;
 use crate::system::SystemMatrix;
+use crate::time::coupling::{ContactCoupling, Iterate, PhaseTimes, StepContact};
 use std::time::Instant;
 
 /// A Newton correction larger than this fraction of the previous one means the contact

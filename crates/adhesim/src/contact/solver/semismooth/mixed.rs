@@ -23,20 +23,20 @@
 //! θ = ½‖Φ‖² evaluates trial points without any further solve. [`solve_mixed`] takes the
 //! directions from a [`MixedDirection`]: [`LuDirection`] factorises the whole matrix by sparse
 //! LU; the time stepper eliminates the forces point by point and solves the rest with its
-//! sparse Cholesky factorisation and GMRES (`time::mixed_coupling`). ηB is a proximal
+//! sparse Cholesky factorisation and GMRES (`super::coupling`). ηB is a proximal
 //! regularisation (x + η r in place of x), which keeps the matrix regular when sticking points
 //! are more than the unknowns can satisfy, and vanishes as the residual does.
 
 use faer::sparse::{Pair, SymbolicSparseColMat};
 
-use super::anisotropic::{scale, unscale};
-use super::cone::{
+use super::reduced::{ARMIJO, ETA_DOWN, ETA_MAX, ETA_MIN, ETA_START, ETA_UP};
+use crate::contact::anisotropic::{scale, unscale};
+use crate::contact::cone::{
     bipotential_trial, dry_projection, modified_displacement_jacobian, projection_jacobian,
 };
-use super::history::PointHistory;
-use super::interface::{Interface, PointSolution};
-use super::law::InterfaceLaw;
-use super::semismooth::{ARMIJO, ETA_DOWN, ETA_MAX, ETA_MIN, ETA_START, ETA_UP};
+use crate::contact::history::PointHistory;
+use crate::contact::interface::{Interface, PointSolution};
+use crate::contact::law::InterfaceLaw;
 use crate::linalg::{metis_dof_ordering, BlockPattern};
 use crate::sparse_lu::OrderedLu;
 use crate::{Mat3, Vec3};
@@ -44,7 +44,7 @@ use crate::{Mat3, Vec3};
 type V3 = [f64; 3];
 
 /// Shortest step length the line search tries (the Armijo constant and the regularisation's
-/// schedule, η relative to the mean 1/ρ, are those of [`super::semismooth`]).
+/// schedule, η relative to the mean 1/ρ, are those of [`super::reduced`]).
 const MIN_STEP: f64 = 1.0 / 1024.0;
 /// Relative round-off of the natural map: the solve stops once the measure is below this
 /// fraction of the forces' norm, whatever the tolerance asked.
@@ -512,13 +512,13 @@ pub fn solve_mixed(
 
 #[cfg(test)]
 mod tests {
-    use super::super::anisotropic::Orthotropy;
-    use super::super::history::LawPointHistory;
-    use super::super::rcc::{BondState, RccParams};
-    use super::super::reduced::test_support::{random_spd, Lcg};
-    use super::super::reduced::BlockSparseDelassus;
-    use super::super::semismooth::semismooth_newton;
+    use super::super::reduced::semismooth_newton;
     use super::*;
+    use crate::contact::anisotropic::Orthotropy;
+    use crate::contact::history::LawPointHistory;
+    use crate::contact::rcc::{BondState, RccParams};
+    use crate::contact::solver::reduced::test_support::{random_spd, Lcg};
+    use crate::contact::solver::reduced::BlockSparseDelassus;
     use crate::Vec2;
 
     /// Central differences of Φ with respect to r (columns of A) and x (columns of B).
@@ -678,7 +678,7 @@ mod tests {
             let (mut pattern, mut eta_rel) = (None, ETA_START);
             let phi = |pts: &[PointSolution]| {
                 let defects = pts.iter().zip(&rho).map(|(pt, &rho)| {
-                    super::super::law::natural_map_defect(&law, rho, pt.r_dry, pt.x)
+                    crate::contact::law::natural_map_defect(&law, rho, pt.r_dry, pt.x)
                 });
                 defects
                     .flat_map(|d| [d[0], d[1], d[2]])

@@ -1,6 +1,7 @@
 //! Semismooth (generalised) Newton method for the reduced dry contact problem x = q + W r of
-//! [`super::reduced`], on the bi-potential natural map (an Alart–Curnier-type method written
-//! with De Saxcé's modified relative displacement instead of the augmented Lagrangian):
+//! [`crate::contact::solver::reduced`], on the bi-potential natural map (an Alart–Curnier-type
+//! method written with De Saxcé's modified relative displacement instead of the augmented
+//! Lagrangian):
 //!
 //! F_α(r) = r_α − P_K(r_α − ρ_α (x_α + μ_α‖x_α,t‖ n)),   x = q + W r,
 //!
@@ -26,7 +27,8 @@
 //! finite, or no step down to 2⁻²⁰ is accepted, a nonlinear Gauss–Seidel sweep
 //! ([`gauss_seidel_sweep`]) is taken instead and Newton resumes from there.
 //!
-//! The iteration stops on Siconos's relative error ([`super::natural_map`]), ρ = 1.
+//! The iteration stops on Siconos's relative error
+//! ([`crate::contact::solver::natural_map`]), ρ = 1.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::solvers::Solve;
@@ -37,11 +39,14 @@ use faer::{Conj, MatMut, Par, Spec};
 
 use crate::linalg::faer_call;
 
-use super::cone::{
+use crate::contact::cone::{
     bipotential_trial, dry_projection, modified_displacement_jacobian, projection_jacobian,
 };
-use super::natural_map::{natural_map_point, natural_map_residual, relative_error};
-use super::reduced::{gauss_seidel_sweep, point_rhos, BlockSparseDelassus, ReducedSolution};
+use crate::contact::solver::gauss_seidel::reduced::{gauss_seidel_sweep, point_rhos};
+use crate::contact::solver::natural_map::{
+    natural_map_point, natural_map_residual, relative_error,
+};
+use crate::contact::solver::reduced::{BlockSparseDelassus, ReducedSolution};
 
 type M3 = [[f64; 3]; 3];
 
@@ -401,9 +406,9 @@ const PROX_INNER: usize = 50;
 
 #[cfg(test)]
 mod tests {
-    use super::super::reduced::gauss_seidel_blocks;
-    use super::super::reduced::test_support::{random_spd, Lcg};
     use super::*;
+    use crate::contact::solver::gauss_seidel::reduced::gauss_seidel_blocks;
+    use crate::contact::solver::reduced::test_support::{random_spd, Lcg};
 
     fn problem(n: usize, seed: u64) -> (BlockSparseDelassus, Vec<[f64; 3]>) {
         let mut rng = Lcg(seed);

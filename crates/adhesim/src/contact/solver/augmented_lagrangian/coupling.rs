@@ -3,13 +3,13 @@
 //! stiffness in K̄, a line search on the step's potential, and the multiplier update once
 //! the equilibrium with the current multipliers is reached.
 
-use super::attempt::PhaseTimes;
-use super::coupling::{ContactCoupling, Evaluated, Iterate, StepContact};
+use super::point::{self, augmented_point, AugmentedPoint};
 use crate::contact::cone::ContactState;
 use crate::contact::interface::PointSolution;
-use crate::contact::newton::{self, augmented_point, AugmentedPoint};
+use crate::contact::solver::site_stiffness::{add_contact_tangent, couplings};
 use crate::rows_of;
 use crate::system::SystemMatrix;
+use crate::time::coupling::{ContactCoupling, Evaluated, Iterate, PhaseTimes, StepContact};
 use std::time::Instant;
 
 /// Newton iterations after which a step that changes the contact cases is line-searched too.
@@ -55,7 +55,7 @@ impl<'a> NewtonCoupling<'a> {
     ) -> Result<Self, String> {
         if !sc.is_empty() {
             system
-                .ensure_couplings(&newton::couplings(&sc.points))
+                .ensure_couplings(&couplings(&sc.points))
                 .map_err(|e| e.to_string())?;
         }
         let n = sc.constraints.mask().len();
@@ -144,7 +144,7 @@ impl<'a> ContactCoupling<'a> for NewtonCoupling<'a> {
         }
         self.line_search = None;
         self.energy = total;
-        let contact_defect = newton::defect_norm(&self.evals);
+        let contact_defect = point::defect_norm(&self.evals);
         // Multiplier update λ ← P_K(λ − ρ x̂(u)) once the equilibrium with the current
         // multipliers is reached to a tenth of the change the update would make.
         if it.iter > 1 && merit <= 0.1 * contact_defect {
@@ -173,7 +173,7 @@ impl<'a> ContactCoupling<'a> for NewtonCoupling<'a> {
             return;
         }
         let stiffness: Vec<_> = self.evals.iter().map(|e| rows_of(&e.stiffness)).collect();
-        newton::add_contact_tangent(&self.sc.points, &stiffness, system);
+        add_contact_tangent(&self.sc.points, &stiffness, system);
     }
 
     fn tangent_key(&self) -> u64 {

@@ -18,7 +18,7 @@
 //! max(‖q‖, ‖r‖, ‖x‖) (q = x at r = 0, the free relative displacement), the normalisation of
 //! Siconos 4.4's `fc3d_compute_error`, and returns the raw norm when all three vanish.
 
-use super::law::{natural_map_defect, InterfaceLaw};
+use crate::contact::law::{natural_map_defect, InterfaceLaw};
 
 /// Natural-map defect F = r − P_K(r − ρ(x + μ‖x_t‖n)) at one point, components (t1, t2, n),
 /// for the force `r` [N], local relative displacement `x` [m], friction coefficient `mu` and
