@@ -55,10 +55,11 @@ pub enum Formulation {
     AveragedNodalPressure,
 }
 
-type Bmat = SMatrix<f64, 6, 3>;
+pub(crate) type Bmat = SMatrix<f64, 6, 3>;
 
+/// The 6×3 block of ∂E/∂u_a (Voigt, engineering shears) at F and G_a = ∂N_a/∂X [1/m].
 #[inline]
-fn b_matrix(f: &Mat3, g: &Vec3) -> Bmat {
+pub(crate) fn b_matrix(f: &Mat3, g: &Vec3) -> Bmat {
     let mut b = Bmat::zeros();
     for i in 0..3 {
         b[(0, i)] = f[(i, 0)] * g[0];
