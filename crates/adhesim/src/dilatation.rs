@@ -402,3 +402,53 @@ pub fn linear_dilatation_cauchy_stress<const N: usize, const G: usize>(
     }
     (sigma / vol, crate::fbar::volume_ratio(gps, u))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::element::{hex20_geometry, HEX20};
+
+    /// A curved, skewed hex20 of size about 2 [m] and its linear space.
+    fn curved() -> ([[f64; 3]; 20], [GaussPoint<20>; 27], LinearDilatation<27>) {
+        let x: [[f64; 3]; 20] = std::array::from_fn(|a| {
+            let c = HEX20.natural_nodes[a];
+            let bend = 0.1 * (1.0 - c[0] * c[0]);
+            [c[0] + 0.2 * c[1], c[1] + 0.1 * c[2] + bend, c[2] + 0.15 * c[0]]
+        });
+        let gps = hex20_geometry(&x).unwrap();
+        let lin = LinearDilatation::new(&gps, &x).unwrap();
+        (x, gps, lin)
+    }
+
+    /// X_g [m] at each Gauss point.
+    fn points(x: &[[f64; 3]; 20], gps: &[GaussPoint<20>; 27]) -> [Vec3; 27] {
+        std::array::from_fn(|g| {
+            (0..20).fold(Vec3::zeros(), |s, a| s + Vec3::from(x[a]) * gps[g].shape[a])
+        })
+    }
+
+    /// A J linear in X is its own projection (to round-off); a quadratic one leaves a
+    /// residual J − θ orthogonal to 1, X, Y and Z under the Gauss rule (the definition of the
+    /// L² projection), and keeps the element's mean.
+    #[test]
+    fn projection_keeps_linear_fields_and_is_orthogonal() {
+        let (x, gps, lin) = curved();
+        let p = points(&x, &gps);
+        let linear: [f64; 27] = p.map(|p| 1.0 + 0.1 * p[0] - 0.2 * p[1] + 0.05 * p[2]);
+        let theta = lin.project(&linear);
+        for (t, j) in theta.iter().zip(&linear) {
+            assert!((t - j).abs() < 1e-14, "{t} against {j}");
+        }
+        let quadratic: [f64; 27] = p.map(|p| 1.0 + 0.3 * p[0] * p[1] - 0.2 * p[2] * p[2]);
+        let theta = lin.project(&quadratic);
+        let mut worst: f64 = 0.0;
+        for f in [|_: &Vec3| 1.0, |p: &Vec3| p[0], |p: &Vec3| p[1], |p: &Vec3| p[2]] {
+            let r: f64 = (0..27)
+                .map(|g| gps[g].weight * (quadratic[g] - theta[g]) * f(&p[g]))
+                .sum();
+            worst = worst.max(r.abs());
+        }
+        assert!(worst < 1e-14, "residual moment {worst}");
+        assert!(theta.iter().zip(&quadratic).any(|(t, j)| (t - j).abs() > 1e-3));
+    }
+}
