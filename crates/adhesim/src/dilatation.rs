@@ -413,7 +413,11 @@ mod tests {
         let x: [[f64; 3]; 20] = std::array::from_fn(|a| {
             let c = HEX20.natural_nodes[a];
             let bend = 0.1 * (1.0 - c[0] * c[0]);
-            [c[0] + 0.2 * c[1], c[1] + 0.1 * c[2] + bend, c[2] + 0.15 * c[0]]
+            [
+                c[0] + 0.2 * c[1],
+                c[1] + 0.1 * c[2] + bend,
+                c[2] + 0.15 * c[0],
+            ]
         });
         let gps = hex20_geometry(&x).unwrap();
         let lin = LinearDilatation::new(&gps, &x).unwrap();
@@ -442,13 +446,21 @@ mod tests {
         let quadratic: [f64; 27] = p.map(|p| 1.0 + 0.3 * p[0] * p[1] - 0.2 * p[2] * p[2]);
         let theta = lin.project(&quadratic);
         let mut worst: f64 = 0.0;
-        for f in [|_: &Vec3| 1.0, |p: &Vec3| p[0], |p: &Vec3| p[1], |p: &Vec3| p[2]] {
+        for f in [
+            |_: &Vec3| 1.0,
+            |p: &Vec3| p[0],
+            |p: &Vec3| p[1],
+            |p: &Vec3| p[2],
+        ] {
             let r: f64 = (0..27)
                 .map(|g| gps[g].weight * (quadratic[g] - theta[g]) * f(&p[g]))
                 .sum();
             worst = worst.max(r.abs());
         }
         assert!(worst < 1e-14, "residual moment {worst}");
-        assert!(theta.iter().zip(&quadratic).any(|(t, j)| (t - j).abs() > 1e-3));
+        assert!(theta
+            .iter()
+            .zip(&quadratic)
+            .any(|(t, j)| (t - j).abs() > 1e-3));
     }
 }

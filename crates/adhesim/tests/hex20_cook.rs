@@ -102,12 +102,12 @@ fn cooks_membrane_on_hex20_with_the_linear_pressure_is_near_the_reference() {
     );
 }
 
-/// The refinement study of docs/elements.md (n = 2 to 32, both forms):
+/// The refinement study of docs/elements.md (n = 2 to 64, both forms):
 /// `cargo test --release -p adhesim --test hex20_cook -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn cooks_membrane_on_hex20_refinement() {
-    for n in [2, 4, 8, 16, 32] {
+    for n in [2, 4, 8, 16, 32, 64] {
         let linear = cook_hex20(n, Formulation::FBar);
         let standard = cook_hex20(n, Formulation::Standard);
         eprintln!(
