@@ -47,7 +47,9 @@ pub enum Formulation {
     /// Full integration with the displacement-based F (locks when nearly incompressible).
     #[default]
     Standard,
-    /// F-bar: the volume change of each Gauss point is the element's mean dilatation (hex8).
+    /// F-bar: the volume change of each Gauss point is the element's mean dilatation (hex8,
+    /// tet10), or on a hex20 the linear projection of J over the element
+    /// ([`crate::dilatation`]).
     FBar,
     /// Averaged nodal pressure for the tetrahedra (see [`crate::anp`]) and F-bar for the
     /// hexahedra of the body; needs an uncoupled (volumetric/isochoric split) material
