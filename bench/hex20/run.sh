@@ -1,6 +1,7 @@
 #!/bin/sh
-# The pressed block of press.toml on hex8 (F-bar) and hex20 (F-bar and standard) meshes of
-# three refinements: the plane's force at the end [N]. Needs Python's gmsh package.
+# The pressed block of press.toml on hex8 (F-bar) and hex20 (element = "fbar": the volume
+# change linear in each element; and standard) meshes of three refinements: the plane's
+# force at the end [N]. Needs Python's gmsh package.
 # Usage: bench/hex20/run.sh [BIN]   (default target/release/adhesim)
 set -eu
 cd "$(dirname "$0")/../.."

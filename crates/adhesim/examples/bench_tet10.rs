@@ -10,15 +10,21 @@
 //!    pressure per element (`Formulation::FBar`) (µs), and the whole mesh's assembly.
 //!
 //! 3. the same assembly per element of the cube's n³ 20-node hexahedra (hex20, 27 Gauss
-//!    points), standard and F-bar, against hex8.
+//!    points), standard and `Formulation::FBar` (on a hex20 the linear volume change,
+//!    Q2/P1), against hex8;
+//! 4. one hex20 element's response with tangent: the linear volume change (Q2/P1) against
+//!    the standard element and against the element-constant one (F-bar, Q2/P0) (µs).
 //!
 //! Each pair (hex8, tet10 or hex20) is timed alternately after one warm-up run of each, so that both
 //! see the same machine load; reported are the median of each and the median of the
 //! per-pair ratios. Usage: `cargo run --release --example bench_tet10 -- [n] [reps]`.
 
 use adhesim::assembly::Discretisation;
-use adhesim::element::{element_response, hex8_geometry, tet10_geometry, TET10};
-use adhesim::fbar::Formulation;
+use adhesim::dilatation::{linear_dilatation_response, LinearDilatation};
+use adhesim::element::{
+    element_response, hex20_geometry, hex8_geometry, tet10_geometry, HEX20, TET10,
+};
+use adhesim::fbar::{fbar_element_response, Formulation};
 use adhesim::material::{Hyperelastic, UncoupledNeoHookean};
 use adhesim::mesh::generate;
 use std::f64::consts::PI;
@@ -158,6 +164,61 @@ fn main() {
         );
     }
     hex20_assembly(&mesh, &hex20, &material, reps, &pool);
+    hex20_kernels(&hex20, mat, reps);
+}
+
+/// Item 4: one hex20's response with tangent, the linear volume change against the standard
+/// element and the element-constant volume change.
+fn hex20_kernels(hex20: &adhesim::mesh::Mesh, mat: &dyn Hyperelastic, reps: usize) {
+    let cell = hex20.cells_of::<20>(&HEX20)[0];
+    let x: [[f64; 3]; 20] = cell.map(|a| hex20.nodes[a]);
+    let gps = hex20_geometry(&x).expect("valid element");
+    let lin = LinearDilatation::new(&gps, &x).expect("valid element");
+    let u: [[f64; 3]; 20] = x.map(displacement);
+    let iters = 2_000;
+    let linear = || {
+        for _ in 0..iters {
+            black_box(linear_dilatation_response(
+                black_box(&gps),
+                &lin,
+                black_box(&u),
+                mat,
+                true,
+                None,
+            ));
+        }
+    };
+    println!();
+    println!("| one hex20's response with tangent | other [µs] | linear volume change [µs] | median of pair ratios linear/other |");
+    println!("|---|---|---|---|");
+    let standard = || {
+        for _ in 0..iters {
+            black_box(element_response(black_box(&gps), black_box(&u), mat, true));
+        }
+    };
+    let constant = || {
+        for _ in 0..iters {
+            black_box(fbar_element_response(
+                black_box(&gps),
+                black_box(&u),
+                mat,
+                true,
+            ));
+        }
+    };
+    for (name, (t_other, t_lin, ratio)) in [
+        ("standard", alternate(reps, standard, linear)),
+        (
+            "element-constant (F-bar, Q2/P0)",
+            alternate(reps, constant, linear),
+        ),
+    ] {
+        println!(
+            "| against {name} | {:.1} | {:.1} | {ratio:.2} |",
+            t_other / iters as f64 * 1e6,
+            t_lin / iters as f64 * 1e6
+        );
+    }
 }
 
 /// Item 3: assembly per element of the hex20 cube `hex20` against the hex8 cube `mesh`.

@@ -12,6 +12,10 @@
 use crate::anp::{
     add_volume_hessian, has_volumetric_split, IsochoricPart, NodalPatches, PatchState,
 };
+use crate::dilatation::{
+    linear_dilatation_c, linear_dilatation_cauchy_stress, linear_dilatation_response,
+    LinearDilatation,
+};
 use crate::element::{
     element_cauchy_stress, element_response_with_history, gauss_point_c, visit_element_types,
     DegenerateElement, Element, ElementResponse, ElementType, ElementTypeVisitor, GaussPoint,
@@ -41,6 +45,9 @@ pub struct ElementBlock<E, const N: usize, const G: usize> {
     /// ([`Element::STABILISATION`]: F-bar hexahedra, averaged-nodal-pressure tetrahedra),
     /// false for the standard fully integrated elements.
     pub fbar: Vec<bool>,
+    /// The linear volume-change space of each element when the type's treatment is
+    /// [`Stabilisation::LinearDilatation`] (empty for the other types).
+    pub dilatation: Vec<LinearDilatation<G>>,
     /// Committed internal variables of viscoelastic elements, all Gauss points one after the
     /// other (empty for elastic elements).
     pub history: Vec<Vec<f64>>,
@@ -76,6 +83,7 @@ impl<E: Element<N, G>, const N: usize, const G: usize> ElementBlock<E, N, G> {
             gauss: vec![],
             body: vec![],
             fbar: vec![],
+            dilatation: vec![],
             history: vec![],
             ranks: vec![],
             colours: vec![],
@@ -89,6 +97,13 @@ impl<E: Element<N, G>, const N: usize, const G: usize> ElementBlock<E, N, G> {
     /// True when there are no elements of this kind.
     pub fn is_empty(&self) -> bool {
         self.nodes.is_empty()
+    }
+}
+
+impl<E, const N: usize, const G: usize> ElementBlock<E, N, G> {
+    /// The linear volume-change space of element `e` when it uses it.
+    fn linear_dilatation(&self, e: usize) -> Option<&LinearDilatation<G>> {
+        self.dilatation.get(e).filter(|_| self.fbar[e])
     }
 }
 
@@ -269,7 +284,7 @@ impl<E: Element<N, G>, const N: usize, const G: usize> Block for ElementBlock<E,
         let gauss = E::geometry(x)?;
         let stabilised = match E::STABILISATION {
             Stabilisation::None => false,
-            Stabilisation::FBar => matches!(
+            Stabilisation::FBar | Stabilisation::LinearDilatation => matches!(
                 formulation,
                 Formulation::FBar | Formulation::AveragedNodalPressure
             ),
@@ -277,6 +292,14 @@ impl<E: Element<N, G>, const N: usize, const G: usize> Block for ElementBlock<E,
                 formulation == Formulation::AveragedNodalPressure && has_volumetric_split(material)
             }
         };
+        if E::STABILISATION == Stabilisation::LinearDilatation {
+            // The Gauss points of a valid element span its volume; the det reported otherwise
+            // is the element's smallest Gauss weight.
+            let lin = LinearDilatation::new(&gauss, x).ok_or(DegenerateElement {
+                det: gauss.iter().map(|g| g.weight).fold(f64::INFINITY, f64::min),
+            })?;
+            self.dilatation.push(lin);
+        }
         self.nodes.push(nodes);
         self.gauss.push(gauss);
         self.body.push(body);
@@ -324,7 +347,9 @@ impl<E: Element<N, G>, const N: usize, const G: usize> Block for ElementBlock<E,
 
     fn cauchy_stress(&self, e: usize, u: &[f64], material: &dyn Hyperelastic) -> (Mat3, f64) {
         let ue = self.nodes[e].map(|n| [u[3 * n], u[3 * n + 1], u[3 * n + 2]]);
-        if self.fbar[e] {
+        if let Some(lin) = self.linear_dilatation(e) {
+            linear_dilatation_cauchy_stress(&self.gauss[e], lin, &ue, material)
+        } else if self.fbar[e] {
             fbar_cauchy_stress(&self.gauss[e], &ue, material)
         } else {
             element_cauchy_stress(&self.gauss[e], &ue, material)
@@ -378,6 +403,7 @@ fn commit_block<E, const N: usize, const G: usize>(
     dt: f64,
 ) {
     let (nodes, gauss, body, fbar) = (&block.nodes, &block.gauss, &block.body, &block.fbar);
+    let block_linear = |e: usize| block.dilatation.get(e).filter(|_| fbar[e]);
     block
         .history
         .par_iter_mut()
@@ -389,7 +415,9 @@ fn commit_block<E, const N: usize, const G: usize>(
             };
             let ue: [[f64; 3]; N] =
                 std::array::from_fn(|a| std::array::from_fn(|i| u[3 * nodes[e][a] + i]));
-            let cs = if fbar[e] {
+            let cs = if let Some(lin) = block_linear(e) {
+                linear_dilatation_c(&gauss[e], lin, &ue)
+            } else if fbar[e] {
                 fbar_gauss_point_c(&gauss[e], &ue)
             } else {
                 gauss_point_c(&gauss[e], &ue)
@@ -710,6 +738,15 @@ impl Discretisation {
                         );
                         add(e, &mut r);
                         r
+                    } else if let Some(lin) = block.linear_dilatation(e) {
+                        linear_dilatation_response(
+                            &block.gauss[e],
+                            lin,
+                            &ue,
+                            mat,
+                            with_tangent,
+                            hist,
+                        )
                     } else if block.fbar[e] {
                         fbar_element_response_with_history(
                             &block.gauss[e],

@@ -47,7 +47,9 @@ pub enum Formulation {
     /// Full integration with the displacement-based F (locks when nearly incompressible).
     #[default]
     Standard,
-    /// F-bar: the volume change of each Gauss point is the element's mean dilatation (hex8).
+    /// F-bar: the volume change of each Gauss point is the element's mean dilatation (hex8,
+    /// tet10), or on a hex20 the linear projection of J over the element
+    /// ([`crate::dilatation`]).
     FBar,
     /// Averaged nodal pressure for the tetrahedra (see [`crate::anp`]) and F-bar for the
     /// hexahedra of the body; needs an uncoupled (volumetric/isochoric split) material
@@ -55,10 +57,11 @@ pub enum Formulation {
     AveragedNodalPressure,
 }
 
-type Bmat = SMatrix<f64, 6, 3>;
+pub(crate) type Bmat = SMatrix<f64, 6, 3>;
 
+/// The 6×3 block of ∂E/∂u_a (Voigt, engineering shears) at F and G_a = ∂N_a/∂X [1/m].
 #[inline]
-fn b_matrix(f: &Mat3, g: &Vec3) -> Bmat {
+pub(crate) fn b_matrix(f: &Mat3, g: &Vec3) -> Bmat {
     let mut b = Bmat::zeros();
     for i in 0..3 {
         b[(0, i)] = f[(i, 0)] * g[0];

@@ -10,7 +10,7 @@
 //!
 //! The public modules are what a program built on the crate uses: the problem
 //! ([`problem`], [`mesh`], [`material`], [`gravity`], the element formulations [`element`],
-//! [`fbar`], [`anp`]), its stepper and what it reports ([`time`], [`assembly`],
+//! [`fbar`], [`dilatation`], [`anp`]), its stepper and what it reports ([`time`], [`assembly`],
 //! [`diagnosis`], [`warnings`]), contact ([`contact`], whose reduced solvers the fclib
 //! benchmarks drive on their own) and the sparse solves the benchmarks time ([`linalg`],
 //! [`sparse_lu`]). The step's system matrix, the prescribed functions of time, the element
@@ -20,6 +20,7 @@ pub mod anp;
 pub mod assembly;
 pub mod contact;
 pub mod diagnosis;
+pub mod dilatation;
 pub mod element;
 pub mod fbar;
 pub mod gravity;

@@ -103,7 +103,7 @@ pub struct Hex20;
 
 impl Element<20, 27> for Hex20 {
     const TYPE: &'static ElementType = &HEX20;
-    const STABILISATION: Stabilisation = Stabilisation::FBar;
+    const STABILISATION: Stabilisation = Stabilisation::LinearDilatation;
 
     fn shape(xi: [f64; 3]) -> ([f64; 20], [[f64; 3]; 20]) {
         hex20_shape(xi)

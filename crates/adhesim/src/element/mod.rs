@@ -169,6 +169,9 @@ pub enum Stabilisation {
     /// F-bar with the element's mean dilatation ([`crate::fbar`]), for the formulations
     /// `FBar` and `AveragedNodalPressure`.
     FBar,
+    /// F-bar with a volume change linear in the element ([`crate::dilatation`], Q2/P1), for
+    /// the formulations `FBar` and `AveragedNodalPressure`.
+    LinearDilatation,
     /// Averaged nodal pressure ([`crate::anp`], built on the tet4 block only), for the formulation
     /// `AveragedNodalPressure` with a material that has a volumetric/isochoric split.
     NodalPressure,
@@ -364,7 +367,7 @@ pub(crate) fn material_point(
 
 /// A zero element tangent allocated in place: `Box::new` of the array would build it on the
 /// stack and copy its N² 3×3 blocks to the heap at every element evaluation.
-fn zeroed_tangent<const N: usize>() -> Box<[[Mat3; N]; N]> {
+pub(crate) fn zeroed_tangent<const N: usize>() -> Box<[[Mat3; N]; N]> {
     // SAFETY: a Mat3 is nine f64 stored inline, and the all-zero bit pattern is 0.0.
     unsafe { Box::<[[Mat3; N]; N]>::new_zeroed().assume_init() }
 }
