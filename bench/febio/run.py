@@ -205,20 +205,22 @@ def force_difference(adh, feb):
 
 def report(a):
     records = [r for r in load_records(a.results) if r["exit"] == 0]
+    commit_of_pair = {r["pair"]: r.get("commit", "") for r in records if r["tool"] == "adhesim"}
     groups = {}
     for r in records:
-        key = (r.get("problem", "pad"), r["n"], r["mu"], " ".join(r.get("adhesim_set", [])))
+        key = (r.get("problem", "pad"), r["n"], r["mu"], " ".join(r.get("adhesim_set", [])),
+               commit_of_pair.get(r["pair"], ""))
         groups.setdefault(key, []).append(r)
     lines = ["# adhesim and FEBio 4 side by side", "",
              f"Written by `bench/febio/run.py` from `bench/febio/results.jsonl` "
              f"(see bench/febio/README.md). Medians over the successful runs; the ratios are "
              f"taken pair by pair (alternating runs) and their median given.", "",
-             "| problem | adhesim settings | contact nodes | μ | pairs | adhesim wall | FEBio wall | wall adhesim/FEBio | "
+             "| problem | adhesim settings | adhesim commit | contact nodes | μ | pairs | adhesim wall | FEBio wall | wall adhesim/FEBio | "
              "CPU adhesim/FEBio | adhesim memory | FEBio memory | adhesim Newton it. / "
              "factorisations | FEBio iterations / reformations | force at the end adhesim, "
              "FEBio | largest force difference over the steps |",
-             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|---|---:|"]
-    for (problem, n, mu, settings), rs in sorted(groups.items()):
+             "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|---|---:|"]
+    for (problem, n, mu, settings, commit), rs in sorted(groups.items()):
         adh = [r for r in rs if r["tool"] == "adhesim"]
         feb = [r for r in rs if r["tool"] == "febio"]
         if not adh or not feb or "forces" not in feb[-1]:
@@ -227,7 +229,8 @@ def report(a):
         walls, cpus = pair_ratios(rs, "wall"), pair_ratios(rs, "cpu")
         la, lf = adh[-1], feb[-1]
         lines.append(
-            f"| {problem} | {settings or 'defaults'} | {contact_nodes(problem, n)} | {mu:g} | {len(walls)} | {med(adh, 'wall'):.2f} s | "
+            f"| {problem} | {settings or 'defaults'} | {commit} | {contact_nodes(problem, n)} | "
+            f"{mu:g} | {len(walls)} | {med(adh, 'wall'):.2f} s | "
             f"{med(feb, 'wall'):.2f} s | {statistics.median(walls):.2f} | "
             f"{statistics.median(cpus):.2f} | {med(adh, 'rss_kb') / 1e6:.2f} GB | "
             f"{med(feb, 'rss_kb') / 1e6:.2f} GB | {la['newton']} / {la['factorisations']} | "
