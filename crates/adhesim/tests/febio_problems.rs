@@ -55,7 +55,12 @@ fn pad_on_a_rigid_plane_matches_febio() {
 #[test]
 fn pad_on_a_soft_block_matches_febio() {
     let f = final_force("blocks", &[], "pad.top.Fy");
-    assert_near("pad on a soft block, mortar, μ = 0.3", f, 8.747072595308596, 1e-2);
+    assert_near(
+        "pad on a soft block, mortar, μ = 0.3",
+        f,
+        8.747072595308596,
+        1e-2,
+    );
 }
 
 /// Both codes give 1.073 of Hertz's force on this coarse tet4 mesh (three linear tetrahedra

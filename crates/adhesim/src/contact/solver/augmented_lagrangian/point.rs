@@ -208,7 +208,10 @@ mod tests {
                 let fm = augmented_dry_force(0.0, rho, lambda, xm).force;
                 for i in 0..3 {
                     let fd = -(fp[i] - fm[i]) / (2.0 * h);
-                    assert!((d.stiffness[(i, k)] - fd).abs() <= 1e-6 * rho, "{i}{k}: {d:?}");
+                    assert!(
+                        (d.stiffness[(i, k)] - fd).abs() <= 1e-6 * rho,
+                        "{i}{k}: {d:?}"
+                    );
                 }
             }
         }
