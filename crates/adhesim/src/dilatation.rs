@@ -36,7 +36,7 @@ use crate::element::{
 use crate::fbar::b_matrix;
 use crate::material::Hyperelastic;
 use crate::{Mat3, Vec3};
-use nalgebra::{Matrix4, Vector4, Vector6};
+use nalgebra::{Matrix4, Vector4};
 
 /// Number of functions of the linear space: 1, X, Y, Z.
 const K: usize = 4;
@@ -185,19 +185,7 @@ fn add_point<const N: usize>(
     let (Some(kt), Some(dmat)) = (kt, dmat) else {
         return;
     };
-    let c = &pt.cbar;
-    let cv = Vector6::new(
-        c[(0, 0)],
-        c[(1, 1)],
-        c[(2, 2)],
-        2.0 * c[(0, 1)],
-        2.0 * c[(1, 2)],
-        2.0 * c[(0, 2)],
-    );
-    let xv = dmat * cv;
-    let x = Mat3::new(
-        xv[0], xv[3], xv[5], xv[3], xv[1], xv[4], xv[5], xv[4], xv[2],
-    );
+    let x = crate::fbar::tangent_on(&dmat, &pt.cbar);
     // 𝔸[F] = F̄ (S + ℂ:C̄) / α and m_a = 𝔸[F] G_a (see crate::fbar).
     let af = pt.fbar * (pt.s + x) / alpha;
     let (a2, wa) = (w * alpha * alpha, w * alpha);

@@ -38,7 +38,7 @@
 
 use crate::element::{displacement_gradient, material_point, ElementResponse, GaussPoint};
 use crate::material::Hyperelastic;
-use crate::{Mat3, Vec3};
+use crate::{Mat3, Mat6, Vec3};
 use nalgebra::{SMatrix, Vector6};
 
 /// Which kinematics an element of a body uses.
@@ -189,20 +189,8 @@ pub fn fbar_element_response_with_history<const N: usize, const G: usize>(
         let (Some(kt), Some(dmat)) = (tangent.as_mut(), dmat) else {
             continue;
         };
-        // 𝔸[F] = F̄ (S + ℂ:C̄) / α, with ℂ:C̄ from the Voigt tangent applied to C̄ written
-        // with engineering shears.
-        let cv = Vector6::new(
-            cbar[(0, 0)],
-            cbar[(1, 1)],
-            cbar[(2, 2)],
-            2.0 * cbar[(0, 1)],
-            2.0 * cbar[(1, 2)],
-            2.0 * cbar[(0, 2)],
-        );
-        let xv = dmat * cv;
-        let x = Mat3::new(
-            xv[0], xv[3], xv[5], xv[3], xv[1], xv[4], xv[5], xv[4], xv[2],
-        );
+        // 𝔸[F] = F̄ (S + ℂ:C̄) / α.
+        let x = tangent_on(&dmat, &cbar);
         let af = fbar * (s + x) / alpha;
         let af_f = af.dot(&f);
         let m: [Vec3; N] = std::array::from_fn(|a| af * grads[a]);
@@ -297,4 +285,21 @@ pub fn fbar_cauchy_stress<const N: usize, const G: usize>(
         vol += gp.weight;
     }
     (sigma / vol, theta)
+}
+
+/// ℂ:C [Pa] for the Voigt tangent `dmat` [Pa] (order xx, yy, zz, xy, yz, xz) and the
+/// symmetric `c` [-], written with engineering shears.
+pub(crate) fn tangent_on(dmat: &Mat6, c: &Mat3) -> Mat3 {
+    let cv = Vector6::new(
+        c[(0, 0)],
+        c[(1, 1)],
+        c[(2, 2)],
+        2.0 * c[(0, 1)],
+        2.0 * c[(1, 2)],
+        2.0 * c[(0, 2)],
+    );
+    let xv = dmat * cv;
+    Mat3::new(
+        xv[0], xv[3], xv[5], xv[3], xv[1], xv[4], xv[5], xv[4], xv[2],
+    )
 }
