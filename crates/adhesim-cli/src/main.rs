@@ -514,6 +514,8 @@ impl Drop for Bar {
 struct Lines {
     start: Instant,
     last: Instant,
+    /// The reason of the latest cut-back since the last line printed.
+    cutback: Option<String>,
 }
 
 impl Lines {
@@ -522,6 +524,7 @@ impl Lines {
         Lines {
             start: now,
             last: now - Duration::from_secs(10),
+            cutback: None,
         }
     }
 }
@@ -529,8 +532,14 @@ impl Lines {
 impl Progress for Lines {
     fn step(&mut self, r: &StepReport, t_end: f64) {
         let done = r.t >= t_end * (1.0 - 1e-12);
+        if let Some(reason) = &r.last_cutback {
+            self.cutback = Some(format!("t = {:.4e} s: {reason}", r.t - r.dt));
+        }
         if self.last.elapsed() < Duration::from_secs(2) && !done {
             return;
+        }
+        if let Some(reason) = self.cutback.take() {
+            eprintln!("  Δt cut back in the step from {reason}");
         }
         self.last = Instant::now();
         let frac = (r.t / t_end).clamp(0.0, 1.0);

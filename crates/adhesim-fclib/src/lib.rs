@@ -659,7 +659,7 @@ pub fn solve_global(
     use adhesim::contact::law::InterfaceLaw;
     use adhesim::contact::solver::natural_map::{natural_map_residual, relative_error};
     use adhesim::contact::solver::semismooth::mixed::{
-        linearise_point, solve_mixed, LuDirection, MixedOperator,
+        linearise_point, solve_mixed, LuDirection, MixedOperator, RELATIVE_SCHEDULE,
     };
     use std::collections::BTreeMap;
 
@@ -783,6 +783,7 @@ pub fn solve_global(
         &q,
         tol,
         max_iter,
+        RELATIVE_SCHEDULE,
         &mut eta_rel,
     )?;
     let x: Vec<[f64; 3]> = sol.points.iter().map(|s| s.x.into()).collect();

@@ -143,6 +143,12 @@ pub enum ContactSolver {
 /// The switch sits above the first, where W is 3 MB.
 pub const AUTO_SEMISMOOTH_FROM: usize = 200;
 
+/// Largest number of contact candidates for which a step whose semismooth solve (chosen by
+/// [`ContactSolver::Auto`]) failed is tried again with Gauss-Seidel on W before Δt is cut:
+/// W then holds at most (3 × 2,000)² values, 288 MB, built from 6,000 solves with K̄'s
+/// factorisation.
+pub const AUTO_GAUSS_SEIDEL_RETRY_MAX: usize = 2_000;
+
 impl ContactSolver {
     /// The solver used for a step with `candidates` contact candidates.
     pub fn for_candidates(self, candidates: usize) -> ContactSolver {

@@ -30,7 +30,7 @@ pub use crate::contact::solver::gauss_seidel::{CachedDelassus, DelassusCache};
 use crate::contact::solver::semismooth::coupling::MixedCoupling;
 use crate::contact::solver::semismooth::mixed::MixedWorkspace;
 use crate::linalg::LinalgError;
-use crate::problem::{ContactSolver, NewtonMethod, Problem};
+use crate::problem::{ContactSolver, NewtonMethod, Problem, AUTO_GAUSS_SEIDEL_RETRY_MAX};
 use crate::system::SystemMatrix;
 use attempt::Attempt;
 use coupling::{Candidates, ContactCoupling, StepContact};
@@ -104,6 +104,8 @@ pub struct StepReport {
     pub newton_iterations: usize,
     /// Attempts discarded (Δt halved) before this step succeeded.
     pub cutbacks: usize,
+    /// Why the last discarded attempt failed (None without cut-backs).
+    pub last_cutback: Option<String>,
     /// Final relative residual.
     pub residual: f64,
     /// Kinetic energy ½ vᵀMv [J].
@@ -271,6 +273,8 @@ pub struct Stepper {
     delassus_cache: DelassusCache,
     /// The semismooth solve's LU analysis, kept while the mixed matrix's pattern stays.
     mixed_workspace: MixedWorkspace,
+    /// Contact candidates of the latest attempt.
+    last_candidates: usize,
     /// Nodal reaction forces of the last committed step [N] (see [`Stepper::reactions`]).
     reactions: Vec<f64>,
     /// Buffers of the Newton loop.
@@ -327,6 +331,7 @@ impl Stepper {
             model_size: 0.0,
             delassus_cache: None,
             mixed_workspace: MixedWorkspace::default(),
+            last_candidates: 0,
             reactions: vec![0.0; n],
             workspace: Workspace::default(),
         };
@@ -469,6 +474,7 @@ impl Stepper {
     pub fn step(&mut self) -> Result<StepReport, StepError> {
         let ts = self.problem.time.clone();
         let mut cutbacks = 0;
+        let mut last_cutback = None;
         loop {
             let remaining = ts.t_end - self.state.t;
             let mut dt = self.dt.min(remaining);
@@ -507,6 +513,7 @@ impl Stepper {
                         dt,
                         newton_iterations: a.iterations,
                         cutbacks,
+                        last_cutback,
                         residual: a.residual,
                         kinetic,
                         internal: a.internal,
@@ -529,6 +536,7 @@ impl Stepper {
                     }
                     self.dt = dt * 0.5;
                     cutbacks += 1;
+                    last_cutback = Some(reason);
                 }
             }
         }
@@ -630,24 +638,43 @@ impl Stepper {
     /// iteration) before the caller cuts Δt back, so that keeping factorisations never
     /// fails a step full Newton solves.
     fn attempt_with_fallback(&mut self, dt: f64) -> Result<Attempt, String> {
-        let method = self.problem.time.newton;
-        let first = self.attempt(dt, method);
-        if first.is_ok() || method == NewtonMethod::Full {
-            return first;
+        let (method, solver) = (self.problem.time.newton, self.problem.time.contact_solver);
+        let mut result = self.attempt(dt, method, solver);
+        if result.is_err() && method != NewtonMethod::Full {
+            result = self.attempt(dt, NewtonMethod::Full, solver);
         }
-        self.attempt(dt, NewtonMethod::Full)
+        let Err(reason) = result else {
+            return result;
+        };
+        // A semismooth solve `auto` chose that failed, on few enough candidates for W: the
+        // same step with Gauss-Seidel on W before Δt is cut.
+        let candidates = self.last_candidates;
+        if solver != ContactSolver::Auto
+            || solver.for_candidates(candidates) != ContactSolver::Semismooth
+            || candidates > AUTO_GAUSS_SEIDEL_RETRY_MAX
+        {
+            return Err(reason);
+        }
+        self.attempt(dt, NewtonMethod::Full, ContactSolver::GaussSeidel)
+            .map_err(|again| format!("{reason}; again with Gauss-Seidel on W: {again}"))
     }
 
     /// One Newton solve over [t, t+dt] under `method`; Err with the reason on failure. The
     /// stages follow docs/model.md §3: detect the contact candidates, predict, then iterate
     /// (assemble, evaluate the contact law, check, factorise and solve, solve the contact
     /// problem, update) until the iterate converges.
-    fn attempt(&mut self, dt: f64, method: NewtonMethod) -> Result<Attempt, String> {
+    fn attempt(
+        &mut self,
+        dt: f64,
+        method: NewtonMethod,
+        contact_solver: ContactSolver,
+    ) -> Result<Attempt, String> {
         self.disc.begin_step(dt);
         let (settings, t1) = (&self.problem.time, self.state.t + dt);
         let f_ext1 = self.external_force(t1);
         let clock = Instant::now();
-        let candidates = self.detect_contact(t1);
+        let candidates = self.detect_contact(t1, contact_solver);
+        self.last_candidates = candidates.points.len();
         let solver = candidates.solver;
         let laws = self
             .problem
@@ -704,7 +731,7 @@ impl Stepper {
     /// at the start of the step, the force their bonds can carry, ‖(A_α √(C w))_α‖ [N] (the
     /// force scale of an interface that holds, or snaps into, contact without load), and, for
     /// the Newton contact solve, the multipliers it starts from.
-    fn detect_contact(&self, t1: f64) -> Candidates {
+    fn detect_contact(&self, t1: f64, contact_solver: ContactSolver) -> Candidates {
         let mut points = if self.problem.contacts.is_empty() {
             Vec::new()
         } else {
@@ -725,11 +752,7 @@ impl Stepper {
             })
             .sum::<f64>()
             .sqrt();
-        let solver = self
-            .problem
-            .time
-            .contact_solver
-            .for_candidates(points.len());
+        let solver = contact_solver.for_candidates(points.len());
         Candidates {
             multipliers: (solver != ContactSolver::GaussSeidel)
                 .then(|| self.multipliers_at_start(&points)),

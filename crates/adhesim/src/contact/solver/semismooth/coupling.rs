@@ -12,6 +12,7 @@
 use super::mixed::{
     add_ht_terms, apply_h_terms, linearise_point, solve_mixed, Direction, LuDirection,
     MixedDirection, MixedOperator, MixedPattern, MixedWorkspace, PointLinearisation,
+    STEPPER_SCHEDULE,
 };
 use crate::contact::detect::ContactPoint;
 use crate::contact::interface::PointSolution;
@@ -166,7 +167,10 @@ impl<'a> ContactCoupling<'a> for MixedCoupling<'a> {
                 factorisation: &mut factorisation,
             };
             let eta = &mut self.workspace.eta_rel;
-            solve_mixed(&mut dir, &law, measure, &rho, r0, x0, tol, MAX_INNER, eta)
+            let schedule = STEPPER_SCHEDULE;
+            solve_mixed(
+                &mut dir, &law, measure, &rho, r0, x0, tol, MAX_INNER, schedule, eta,
+            )
         };
         let mut sol = solve(system, &self.r_contact, &x0, &momentum)?;
         let mut iterations = sol.iterations;

@@ -43,9 +43,32 @@ use crate::{Mat3, Vec3};
 
 type V3 = [f64; 3];
 
-/// Shortest step length the line search tries (the Armijo constant and the regularisation's
-/// schedule, η relative to the mean 1/ρ, are those of [`super::reduced`]).
-const MIN_STEP: f64 = 1.0 / 1024.0;
+/// How [`solve_mixed`] shortens its steps and lowers its regularisation (the Armijo constant
+/// and η's bounds and factors, relative to the mean 1/ρ, are those of [`super::reduced`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MixedSchedule {
+    /// Shortest step length the line search tries.
+    pub min_step: f64,
+    /// Whether the caller's measure is relative (dimensionless). Then η's level is at most
+    /// the measure, as in [`super::reduced::semismooth_newton`]; otherwise at most ‖Φ‖
+    /// relative to the forces' norm.
+    pub relative_measure: bool,
+}
+
+/// The time stepper's schedule: its measure is a force [N].
+pub const STEPPER_SCHEDULE: MixedSchedule = MixedSchedule {
+    min_step: 1.0 / 1024.0,
+    relative_measure: false,
+};
+
+/// The schedule of a relative measure, with the reduced method's shortest step: on the
+/// degenerate problems of rigid bodies with more contacts than freedoms (fclib's
+/// spheres-in-a-box) the line search needs steps down to 2⁻²⁰ and η that follows the error.
+pub const RELATIVE_SCHEDULE: MixedSchedule = MixedSchedule {
+    min_step: 1.0 / (1u64 << 20) as f64,
+    relative_measure: true,
+};
+
 /// Relative round-off of the natural map: the solve stops once the measure is below this
 /// fraction of the forces' norm, whatever the tolerance asked.
 const ROUND_OFF: f64 = 1e-13;
@@ -410,7 +433,8 @@ impl MixedDirection for LuDirection<'_, '_> {
 /// another ρ; Φ's norm with these ρ is the merit of the line search). A direction whose
 /// displacement part has an out-of-balance force m of its own removes it as well: what is
 /// left of it, s m with s = Π(1 − t) over the steps t taken, adds ½ (s ‖m‖)² to the merit and
-/// must be ≤ `tol` too. `eta_rel` carries the regularisation level from call to call.
+/// must be ≤ `tol` too. `schedule` says how steps are shortened and η lowered; `eta_rel`
+/// carries the regularisation level from call to call.
 #[allow(clippy::too_many_arguments)]
 pub fn solve_mixed(
     dir: &mut impl MixedDirection,
@@ -421,6 +445,7 @@ pub fn solve_mixed(
     x0: &[V3],
     tol: f64,
     max_iter: usize,
+    schedule: MixedSchedule,
     eta_rel: &mut f64,
 ) -> Result<MixedSolution, String> {
     let (n, m) = (dir.unknowns(), r0.len());
@@ -469,13 +494,17 @@ pub fn solve_mixed(
         let level = if failed {
             *eta_rel
         } else {
-            eta_rel.min(residual / (force + residual))
+            eta_rel.min(if schedule.relative_measure {
+                measured
+            } else {
+                residual / (force + residual)
+            })
         };
         let level = level.max(dir.eta_floor());
         let mut accepted = false;
         if let Some(step) = dir.direction(&lin, eta_scale * level, s)? {
             let mut t = 1.0;
-            while t >= MIN_STEP {
+            while t >= schedule.min_step {
                 let r_try: Vec<V3> = (0..m)
                     .map(|p| std::array::from_fn(|k| r[p][k] + t * step.d[p][k]))
                     .collect();
@@ -711,6 +740,7 @@ mod tests {
                     &start,
                     tol,
                     100,
+                    STEPPER_SCHEDULE,
                     &mut eta_rel,
                 )
                 .expect("analysis");
