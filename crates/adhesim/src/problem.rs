@@ -101,9 +101,12 @@ pub struct TimeSettings {
 /// How the Newton iterations of a step use the factorisation of K̄.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum NewtonMethod {
+    /// `Preconditioned` for a step whose contact is solved inside the Newton loop (the
+    /// augmented-Lagrangian solve), `Full` otherwise ([`NewtonMethod::for_contact`]).
+    #[default]
+    Auto,
     /// A new factorisation for every Newton correction (and for every direction of the
     /// semismooth contact solve).
-    #[default]
     Full,
     /// The Newton loop keeps its factorisation, within and across steps, while the
     /// iterations contract with it ([`crate::time::factor_reuse`]), and factorises again
@@ -118,6 +121,20 @@ pub enum NewtonMethod {
     Preconditioned,
 }
 
+impl NewtonMethod {
+    /// The method of a step whose contact solver is `solver`: `Auto` resolved, the others
+    /// kept. Only the augmented-Lagrangian solve leaves K̄ to the Newton loop alone; the
+    /// Gauss-Seidel solve builds W from K̄'s factorisation, which must then be that of the
+    /// iterate, and the semismooth solve factorises its own matrices.
+    pub fn for_contact(self, solver: ContactSolver) -> NewtonMethod {
+        match (self, solver) {
+            (NewtonMethod::Auto, ContactSolver::Newton) => NewtonMethod::Preconditioned,
+            (NewtonMethod::Auto, _) => NewtonMethod::Full,
+            (other, _) => other,
+        }
+    }
+}
+
 /// How the contact conditions are solved in each Newton iteration (docs/contact-solver.md).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum ContactSolver {
@@ -130,10 +147,14 @@ pub enum ContactSolver {
     /// The reduced system on the dense Delassus operator W = H K̄⁻¹ Hᵀ, solved by nonlinear
     /// Gauss-Seidel over contact points (small problems, cross-checks).
     GaussSeidel,
-    /// Gauss-Seidel for a step with fewer than [`AUTO_SEMISMOOTH_FROM`] contact candidates,
-    /// the semismooth solve from there on.
+    /// Gauss-Seidel for a step with fewer than [`AUTO_SEMISMOOTH_FROM`] contact candidates;
+    /// from there on the augmented-Lagrangian solve where every candidate is frictionless and
+    /// without adhesion, the semismooth solve otherwise.
     #[default]
     Auto,
+    /// `Auto` without the augmented-Lagrangian solve: what `Auto` becomes in a run once that
+    /// solve has failed on one of its steps.
+    AutoWithoutNewton,
 }
 
 /// Contact candidates from which [`ContactSolver::Auto`] solves a step without W. Measured
@@ -150,13 +171,23 @@ pub const AUTO_SEMISMOOTH_FROM: usize = 200;
 pub const AUTO_GAUSS_SEIDEL_RETRY_MAX: usize = 2_000;
 
 impl ContactSolver {
-    /// The solver used for a step with `candidates` contact candidates.
-    pub fn for_candidates(self, candidates: usize) -> ContactSolver {
+    /// The solver used for a step with `candidates` contact candidates, all frictionless
+    /// and without adhesion when `frictionless_dry`. Measured (docs/contact-solver.md): on the
+    /// frictionless pad at 10⁴ contact nodes the augmented-Lagrangian solve with the
+    /// preconditioned Newton loop takes 0.45 of the semismooth solve's time.
+    pub fn for_step(self, candidates: usize, frictionless_dry: bool) -> ContactSolver {
         match self {
-            ContactSolver::Auto if candidates >= AUTO_SEMISMOOTH_FROM => ContactSolver::Semismooth,
-            ContactSolver::Auto => ContactSolver::GaussSeidel,
+            ContactSolver::Auto if candidates < AUTO_SEMISMOOTH_FROM => ContactSolver::GaussSeidel,
+            ContactSolver::Auto if frictionless_dry => ContactSolver::Newton,
+            ContactSolver::Auto => ContactSolver::Semismooth,
+            ContactSolver::AutoWithoutNewton => ContactSolver::Auto.for_step(candidates, false),
             other => other,
         }
+    }
+
+    /// [`ContactSolver::for_step`] of a step with friction or adhesion.
+    pub fn for_candidates(self, candidates: usize) -> ContactSolver {
+        self.for_step(candidates, false)
     }
 }
 
@@ -287,6 +318,33 @@ mod contact_solver_tests {
         ] {
             assert_eq!(s.for_candidates(10 * AUTO_SEMISMOOTH_FROM), s);
             assert_eq!(s.for_candidates(1), s);
+            assert_eq!(s.for_step(10 * AUTO_SEMISMOOTH_FROM, true), s);
+        }
+    }
+
+    /// Frictionless dry steps from the threshold on take the augmented-Lagrangian solve, and
+    /// the "auto" Newton method keeps its factorisation as a preconditioner there only.
+    #[test]
+    fn auto_takes_the_augmented_lagrangian_for_large_frictionless_dry_steps() {
+        let auto = ContactSolver::Auto;
+        assert_eq!(
+            auto.for_step(AUTO_SEMISMOOTH_FROM - 1, true),
+            ContactSolver::GaussSeidel
+        );
+        assert_eq!(
+            auto.for_step(AUTO_SEMISMOOTH_FROM, true),
+            ContactSolver::Newton
+        );
+        let method = NewtonMethod::Auto;
+        assert_eq!(
+            method.for_contact(ContactSolver::Newton),
+            NewtonMethod::Preconditioned
+        );
+        for s in [ContactSolver::GaussSeidel, ContactSolver::Semismooth] {
+            assert_eq!(method.for_contact(s), NewtonMethod::Full);
+        }
+        for m in [NewtonMethod::Full, NewtonMethod::Modified] {
+            assert_eq!(m.for_contact(ContactSolver::Newton), m);
         }
     }
 }

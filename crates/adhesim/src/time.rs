@@ -91,6 +91,14 @@ pub struct StepError {
     pub reason: String,
 }
 
+/// The contact candidates, contact solver and Newton method of an attempt at a step.
+#[derive(Clone, Copy, Debug, Default)]
+struct AttemptKind {
+    candidates: usize,
+    solver: ContactSolver,
+    method: NewtonMethod,
+}
+
 /// What one committed step did.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StepReport {
@@ -273,8 +281,11 @@ pub struct Stepper {
     delassus_cache: DelassusCache,
     /// The semismooth solve's LU analysis, kept while the mixed matrix's pattern stays.
     mixed_workspace: MixedWorkspace,
-    /// Contact candidates of the latest attempt.
-    last_candidates: usize,
+    /// What the latest attempt was.
+    last_attempt: AttemptKind,
+    /// Set when a step on which `auto` chose the augmented-Lagrangian contact solve failed:
+    /// `auto` no longer chooses it in this run.
+    auto_without_newton_contact: bool,
     /// Nodal reaction forces of the last committed step [N] (see [`Stepper::reactions`]).
     reactions: Vec<f64>,
     /// Buffers of the Newton loop.
@@ -331,7 +342,8 @@ impl Stepper {
             model_size: 0.0,
             delassus_cache: None,
             mixed_workspace: MixedWorkspace::default(),
-            last_candidates: 0,
+            last_attempt: AttemptKind::default(),
+            auto_without_newton_contact: false,
             reactions: vec![0.0; n],
             workspace: Workspace::default(),
         };
@@ -638,25 +650,42 @@ impl Stepper {
     /// iteration) before the caller cuts Δt back, so that keeping factorisations never
     /// fails a step full Newton solves.
     fn attempt_with_fallback(&mut self, dt: f64) -> Result<Attempt, String> {
-        let (method, solver) = (self.problem.time.newton, self.problem.time.contact_solver);
+        let (method, configured) = (self.problem.time.newton, self.problem.time.contact_solver);
+        let solver = if self.auto_without_newton_contact {
+            ContactSolver::AutoWithoutNewton
+        } else {
+            configured
+        };
         let mut result = self.attempt(dt, method, solver);
-        if result.is_err() && method != NewtonMethod::Full {
+        if result.is_err() && self.last_attempt.method != NewtonMethod::Full {
             result = self.attempt(dt, NewtonMethod::Full, solver);
         }
         let Err(reason) = result else {
             return result;
         };
-        // A semismooth solve `auto` chose that failed, on few enough candidates for W: the
-        // same step with Gauss-Seidel on W before Δt is cut.
-        let candidates = self.last_candidates;
-        if solver != ContactSolver::Auto
-            || solver.for_candidates(candidates) != ContactSolver::Semismooth
-            || candidates > AUTO_GAUSS_SEIDEL_RETRY_MAX
-        {
+        let last = self.last_attempt;
+        if !matches!(
+            solver,
+            ContactSolver::Auto | ContactSolver::AutoWithoutNewton
+        ) {
             return Err(reason);
         }
-        self.attempt(dt, NewtonMethod::Full, ContactSolver::GaussSeidel)
-            .map_err(|again| format!("{reason}; again with Gauss-Seidel on W: {again}"))
+        match last.solver {
+            // The augmented-Lagrangian solve `auto` chose failed: this step and the rest of
+            // the run with the semismooth solve (and Gauss-Seidel below its threshold).
+            ContactSolver::Newton => {
+                self.auto_without_newton_contact = true;
+                self.attempt_with_fallback(dt).map_err(|again| {
+                    format!("{reason}; again without the augmented Lagrangian: {again}")
+                })
+            }
+            // A failed semismooth solve on few enough candidates for W: the same step with
+            // Gauss-Seidel on W before Δt is cut.
+            ContactSolver::Semismooth if last.candidates <= AUTO_GAUSS_SEIDEL_RETRY_MAX => self
+                .attempt(dt, NewtonMethod::Full, ContactSolver::GaussSeidel)
+                .map_err(|again| format!("{reason}; again with Gauss-Seidel on W: {again}")),
+            _ => Err(reason),
+        }
     }
 
     /// One Newton solve over [t, t+dt] under `method`; Err with the reason on failure. The
@@ -674,8 +703,13 @@ impl Stepper {
         let f_ext1 = self.external_force(t1);
         let clock = Instant::now();
         let candidates = self.detect_contact(t1, contact_solver);
-        self.last_candidates = candidates.points.len();
         let solver = candidates.solver;
+        let method = method.for_contact(solver);
+        self.last_attempt = AttemptKind {
+            candidates: candidates.points.len(),
+            solver,
+            method,
+        };
         let laws = self
             .problem
             .contacts
@@ -752,7 +786,11 @@ impl Stepper {
             })
             .sum::<f64>()
             .sqrt();
-        let solver = contact_solver.for_candidates(points.len());
+        let frictionless_dry = points.iter().all(|pt| {
+            let law = &self.problem.contacts[pt.pair].law;
+            law.is_frictionless() && !law.is_adhesive()
+        });
+        let solver = contact_solver.for_step(points.len(), frictionless_dry);
         Candidates {
             multipliers: (solver != ContactSolver::GaussSeidel)
                 .then(|| self.multipliers_at_start(&points)),

@@ -107,16 +107,19 @@ fn newton(t: &FileTime, d: &TimeSettings, ctx: &Ctx) -> Result<(f64, usize), Sce
     Ok((newton_tol, max_newton))
 }
 
-/// Whether `time.newton` asks for a new factorisation at every iteration (`"full"`, the
-/// default), keeps one while the iterations converge (`"modified"`), or keeps one as the
-/// preconditioner of an iterative solve of each correction (`"preconditioned"`).
+/// Whether `time.newton` asks for a new factorisation at every iteration (`"full"`), keeps
+/// one while the iterations converge (`"modified"`), keeps one as the preconditioner of an
+/// iterative solve of each correction (`"preconditioned"`), or leaves the choice to the
+/// step's contact solver (`"auto"`, the default: preconditioned with the augmented-Lagrangian
+/// solve, full otherwise).
 fn newton_method(t: &FileTime, ctx: &Ctx) -> Result<NewtonMethod, ScenarioError> {
     match t.newton.as_deref() {
-        None | Some("full") => Ok(NewtonMethod::Full),
+        None | Some("auto") => Ok(NewtonMethod::Auto),
+        Some("full") => Ok(NewtonMethod::Full),
         Some("modified") => Ok(NewtonMethod::Modified),
         Some("preconditioned") => Ok(NewtonMethod::Preconditioned),
         Some(m) => Err(ctx.err(format!(
-            "`time.newton` = {m:?}; valid values are \"full\", \"modified\" and \"preconditioned\""
+            "`time.newton` = {m:?}; valid values are \"auto\", \"full\", \"modified\" and \"preconditioned\""
         ))),
     }
 }

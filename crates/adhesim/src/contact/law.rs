@@ -75,6 +75,11 @@ impl InterfaceLaw {
         }
     }
 
+    /// Whether the law has no friction (μ ≤ 0 along both axes).
+    pub fn is_frictionless(&self) -> bool {
+        self.mu <= 0.0 && self.anisotropy.as_ref().is_none_or(|o| o.mu2 <= 0.0)
+    }
+
     /// The scale s = μ₂/μ₁ of the second tangential axis that maps the law's cone on the
     /// circular cone of μ₁ ([`super::anisotropic`]): 1 for an isotropic law (and for μ₁ = μ₂).
     pub fn tangent_scale(&self) -> f64 {
