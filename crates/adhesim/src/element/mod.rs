@@ -210,6 +210,30 @@ pub trait Element<const N: usize, const G: usize>: Send + Sync + 'static {
     fn mass(gps: &[GaussPoint<N>; G], density: f64) -> [[f64; N]; N] {
         quadrature_mass(gps, density)
     }
+
+    /// How `time.mass = "lumped"` makes this element's mass diagonal: by default the row
+    /// sums of the consistent mass.
+    const LUMPING: Lumping = Lumping::RowSum;
+}
+
+/// How an element's consistent mass is made diagonal (`time.mass = "lumped"`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lumping {
+    /// m_a = Σ_b m_ab: the row sums. Positive for the linear elements (hex8, tet4), whose
+    /// shape functions are non-negative; negative at the corners of the quadratic ones.
+    RowSum,
+    /// m_a = m_aa · Σ_bc m_bc / Σ_c m_cc: the consistent mass's diagonal scaled so that the
+    /// element keeps its total mass (Hinton, Rock and Zienkiewicz, Earthquake Engng. Struct.
+    /// Dyn. 4 (1976) 245). Every m_a is positive, since every m_aa = ∫ ρ N_a² dV₀ is.
+    DiagonalScaling,
+}
+
+/// The diagonal-scaling lumped mass of a consistent element mass `m` [kg] ([`Lumping`]):
+/// its diagonal times the total Σ_ab m_ab over the trace Σ_a m_aa.
+pub fn diagonal_scaling_lumped<const N: usize>(m: &[[f64; N]; N]) -> [f64; N] {
+    let total: f64 = m.iter().flatten().sum();
+    let trace: f64 = (0..N).map(|a| m[a][a]).sum();
+    std::array::from_fn(|a| m[a][a] * (total / trace))
 }
 
 /// Shape functions N_a and their natural derivatives ∂N_a/∂ξ at one point, one entry per
