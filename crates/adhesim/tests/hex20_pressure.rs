@@ -127,7 +127,7 @@ fn bending_pressure_errors(pressures: &[(f64, [f64; 3])], p_over_i: f64) -> (f64
 }
 
 /// The element-to-element oscillation along the top row of elements (y = h − h/(2 ny)): for
-/// the k-th element from the clamp, |p_k − (p_(k−1) + p_(k+1))/2| (zero for a field linear
+/// the k-th element from the clamp (counted from 0 at the clamp; entry k − 1 of the result), |p_k − (p_(k−1) + p_(k+1))/2| (zero for a field linear
 /// in x, twice the amplitude for a checkerboard), over the largest Saint-Venant pressure
 /// (at the clamp, the top fibre).
 fn top_row_oscillation(pressures: &[(f64, [f64; 3])], p_over_i: f64) -> Vec<f64> {
