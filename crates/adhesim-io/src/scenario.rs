@@ -477,7 +477,6 @@ fn validate(raw: FileScenario, ctx: &Ctx) -> Result<Scenario, ScenarioError> {
     let name = scenario_name(raw.name.as_deref(), ctx)?;
     let time = time::validate_time(&raw.time, ctx)?;
     let bodies = Bodies::build(&raw.bodies, ctx)?;
-    bodies.check_lumped_mass(time.lumped_mass, ctx)?;
     let mut constraints = Constraints::plane_strain(&bodies);
     constraints.add_boundaries(&raw.boundaries, &bodies, ctx)?;
     let loads = boundaries::build_loads(&raw.loads, &bodies, ctx)?;

@@ -17,9 +17,9 @@ use crate::dilatation::{
     LinearDilatation,
 };
 use crate::element::{
-    element_cauchy_stress, element_response_with_history, gauss_point_c, visit_element_types,
-    DegenerateElement, Element, ElementResponse, ElementType, ElementTypeVisitor, GaussPoint,
-    Stabilisation, Tet4,
+    diagonal_scaling_lumped, element_cauchy_stress, element_response_with_history, gauss_point_c,
+    visit_element_types, DegenerateElement, Element, ElementResponse, ElementType,
+    ElementTypeVisitor, GaussPoint, Lumping, Stabilisation, Tet4,
 };
 use crate::fbar::{
     fbar_cauchy_stress, fbar_element_response_with_history, fbar_gauss_point_c, Formulation,
@@ -439,6 +439,15 @@ fn mass_block<E: Element<N, G>, const N: usize, const G: usize>(
     for e in 0..block.len() {
         let me = E::mass(&block.gauss[e], density[block.body[e]]);
         let en = &block.nodes[e];
+        if lumped && E::LUMPING == Lumping::DiagonalScaling {
+            for (a, ma) in diagonal_scaling_lumped(&me).into_iter().enumerate() {
+                let r = block.ranks[e][a][a] as usize;
+                for k in 0..3 {
+                    m[pattern.position(r, en[a], k, k)] += ma;
+                }
+            }
+            continue;
+        }
         for a in 0..N {
             for b in 0..N {
                 let (na, nb) = (en[a], en[b]);
@@ -850,8 +859,9 @@ impl Discretisation {
         }
     }
 
-    /// Mass matrix values in pattern order [kg], consistent or row-sum lumped, from the
-    /// density [kg/m³] of each body.
+    /// Mass matrix values in pattern order [kg], consistent or lumped (each element type's
+    /// [`Lumping`]: row sums on hex8 and tet4, the scaled diagonal on tet10 and hex20), from
+    /// the density [kg/m³] of each body.
     pub fn mass(&self, density: &[f64], lumped: bool) -> Vec<f64> {
         let mut m = vec![0.0; self.pattern.nnz()];
         for b in &self.blocks {

@@ -220,6 +220,8 @@ pub enum Cells {
     Tet10,
     /// The hexahedra with a node at the middle of each edge.
     Hex20,
+    /// The hex20 with a node at the centre of each face and of each cell.
+    Hex27,
 }
 
 impl Cells {
@@ -231,6 +233,7 @@ impl Cells {
             Cells::Tet4 => hexes.split_hexes_into_tets(),
             Cells::Tet10 => hexes.split_hexes_into_tets().with_mid_side_nodes(),
             Cells::Hex20 => hexes.with_mid_side_nodes(),
+            Cells::Hex27 => hexes.with_mid_side_nodes().with_face_and_centre_nodes(),
         }
     }
 }

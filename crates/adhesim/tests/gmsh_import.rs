@@ -292,13 +292,13 @@ fn malformed_files_give_errors_with_file_and_line() {
     assert_eq!(e.location, Some(Location::Line(2)));
     assert!(e.message.contains("version 2.2 is not supported"), "{e}");
 
-    // 27-node hexahedra.
+    // Third-order (20-node) tetrahedra.
     let hex_block = "3 2 5 288";
-    let (bad, at) = replace_line_after(&text, "$Elements", hex_block, "3 2 12 288");
-    let e = read_bad("hex27.msh", bad.as_bytes());
+    let (bad, at) = replace_line_after(&text, "$Elements", hex_block, "3 2 29 288");
+    let e = read_bad("tet20.msh", bad.as_bytes());
     assert_eq!(e.location, Some(Location::Line(at)), "{e}");
     assert!(
-        e.message.contains("hex27 (Gmsh type 12) is not supported: the volume elements adhesim reads are hex8, tet4, tet10, hex20: remesh with first-order elements (Mesh.ElementOrder = 1), or at second order with Mesh.ElementOrder = 2 and Mesh.SecondOrderIncomplete = 1"),
+        e.message.contains("tet20 (Gmsh type 29) is not supported: the volume elements adhesim reads are hex8, tet4, tet10, hex20, hex27: remesh with first-order elements (Mesh.ElementOrder = 1), or at second order with Mesh.ElementOrder = 2 (tet10, hex27; with Mesh.SecondOrderIncomplete = 1, hex20)"),
         "{e}"
     );
 

@@ -48,24 +48,6 @@ impl Bodies {
         })
     }
 
-    /// Refuses a lumped mass matrix (`time.mass = "lumped"`) on a body with second-order
-    /// elements: their row-sum lumped mass gives the corner nodes negative masses.
-    pub(super) fn check_lumped_mass(&self, lumped: bool, ctx: &Ctx) -> Result<(), ScenarioError> {
-        let quadratic = self.list.iter().find_map(|b| {
-            b.mesh
-                .blocks
-                .iter()
-                .find(|blk| !blk.is_empty() && blk.element.is_quadratic())
-                .map(|blk| (&b.name, blk.element.name))
-        });
-        match quadratic {
-            Some((body, element)) if lumped => Err(ctx.err(format!(
-                "`time.mass` = \"lumped\": body {body:?} has second-order elements ({element}), whose row-sum lumped mass gives the corner nodes negative masses; use \"consistent\" (the default)"
-            ))),
-            _ => Ok(()),
-        }
-    }
-
     /// Index of the body called `name`, which the scenario gives at `key` (e.g.
     /// `contact[0].slave.body`).
     pub(super) fn body(&self, key: &str, name: &str, ctx: &Ctx) -> Result<usize, ScenarioError> {

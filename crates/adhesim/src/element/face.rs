@@ -6,12 +6,13 @@
 //! type names the type of each of its faces ([`LocalFace`]); a mesh face is a face type and
 //! its node indices ([`crate::mesh::Face`]). Code that treats faces asks their type, so a new
 //! face type is one static with its functions, next to the element type it comes from:
-//! quad4 (`hex8.rs`), tri3 (`tet4.rs`), tri6 (`tet10.rs`), quad8 (`hex20.rs`).
+//! quad4 (`hex8.rs`), tri3 (`tet4.rs`), tri6 (`tet10.rs`), quad8 (`hex20.rs`), quad9
+//! (`hex27.rs`).
 
 use crate::Vec3;
 
-/// The largest node count of a face type (the eight-node quadrilateral).
-pub const MAX_FACE_NODES: usize = 8;
+/// The largest node count of a face type (the nine-node quadrilateral).
+pub const MAX_FACE_NODES: usize = 9;
 
 /// Shape functions N_a and their derivatives (∂N_a/∂ξ, ∂N_a/∂η) at one point of a face's
 /// natural coordinates, one entry per node.
@@ -81,7 +82,7 @@ impl std::hash::Hash for FaceType {
 
 impl FaceType {
     /// The face types of the element types of [`super::ELEMENT_TYPES`], each once, in the
-    /// order of the table (quad4, tri3, tri6, quad8).
+    /// order of the table (quad4, tri3, tri6, quad8, quad9).
     pub fn all() -> Vec<&'static FaceType> {
         let mut out: Vec<&'static FaceType> = Vec::new();
         for t in super::ELEMENT_TYPES {

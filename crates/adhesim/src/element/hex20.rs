@@ -18,7 +18,7 @@ use super::face::{
     gauss_newton_projection, onto_square, square_quadrature, FaceProjection, FaceType, LocalFace,
 };
 use super::hex8::HEX_CORNER_FRAMES;
-use super::{DegenerateElement, Element, ElementType, GaussPoint, Stabilisation};
+use super::{DegenerateElement, Element, ElementType, GaussPoint, Lumping, Stabilisation};
 use crate::Vec3;
 
 /// The edges of the mid-edge nodes 8..19, by their end corners (VTK order).
@@ -104,6 +104,8 @@ pub struct Hex20;
 impl Element<20, 27> for Hex20 {
     const TYPE: &'static ElementType = &HEX20;
     const STABILISATION: Stabilisation = Stabilisation::LinearDilatation;
+    /// The row sums would give the corners −ρV/8 each (for a parallelepiped).
+    const LUMPING: Lumping = Lumping::DiagonalScaling;
 
     fn shape(xi: [f64; 3]) -> ([f64; 20], [[f64; 3]; 20]) {
         hex20_shape(xi)

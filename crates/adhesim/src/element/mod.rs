@@ -12,14 +12,15 @@
 //!   Gauss point).
 //!
 //! The types are trilinear hex8 (2×2×2 Gauss, `hex8.rs`), linear tet4 (1 point, `tet4.rs`),
-//! quadratic tet10 (4 points, `tet10.rs`) and quadratic (serendipity) hex20 (3×3×3 points,
-//! `hex20.rs`). Their faces are described by face types (`face.rs`).
+//! quadratic tet10 (4 points, `tet10.rs`), quadratic (serendipity) hex20 (3×3×3 points,
+//! `hex20.rs`) and triquadratic (Lagrange) hex27 (3×3×3 points, `hex27.rs`). Their faces are described by face types (`face.rs`).
 //! Reference-configuration data (shape-function gradients, weights) are computed once; the
 //! kernels turn nodal displacements into internal force, consistent tangent (material +
 //! geometric) and strain energy.
 
 pub mod face;
 pub(crate) mod hex20;
+pub(crate) mod hex27;
 pub(crate) mod hex8;
 pub(crate) mod tet10;
 pub(crate) mod tet4;
@@ -28,6 +29,9 @@ pub use face::{FaceType, LocalFace};
 pub use hex20::{
     hex20_geometry, hex20_shape, quad8_shape, Hex20, HEX20, HEX20_EDGES, HEX20_NODE_XI, QUAD8,
     QUAD8_NODE_XI,
+};
+pub use hex27::{
+    hex27_geometry, hex27_shape, quad9_shape, Hex27, HEX27, HEX27_NODE_XI, QUAD9, QUAD9_NODE_XI,
 };
 pub use hex8::{
     hex8_centre, hex8_gauss_points, hex8_geometry, hex8_shape, quad4_shape, Hex8, HEX8,
@@ -67,6 +71,7 @@ element_types! {
     Tet4, 4, 1, TET4;
     Tet10, 10, 4, TET10;
     Hex20, 20, 27, HEX20;
+    Hex27, 27, 27, HEX27;
 }
 
 /// What is done with each element type's Rust type ([`visit_element_types`]).
@@ -210,6 +215,30 @@ pub trait Element<const N: usize, const G: usize>: Send + Sync + 'static {
     fn mass(gps: &[GaussPoint<N>; G], density: f64) -> [[f64; N]; N] {
         quadrature_mass(gps, density)
     }
+
+    /// How `time.mass = "lumped"` makes this element's mass diagonal: by default the row
+    /// sums of the consistent mass.
+    const LUMPING: Lumping = Lumping::RowSum;
+}
+
+/// How an element's consistent mass is made diagonal (`time.mass = "lumped"`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lumping {
+    /// m_a = Σ_b m_ab: the row sums. Positive for the linear elements (hex8, tet4), whose
+    /// shape functions are non-negative; negative at the corners of the quadratic ones.
+    RowSum,
+    /// m_a = m_aa · Σ_bc m_bc / Σ_c m_cc: the consistent mass's diagonal scaled so that the
+    /// element keeps its total mass (Hinton, Rock and Zienkiewicz, Earthquake Engng. Struct.
+    /// Dyn. 4 (1976) 245). Every m_a is positive, since every m_aa = ∫ ρ N_a² dV₀ is.
+    DiagonalScaling,
+}
+
+/// The diagonal-scaling lumped mass of a consistent element mass `m` [kg] ([`Lumping`]):
+/// its diagonal times the total Σ_ab m_ab over the trace Σ_a m_aa.
+pub fn diagonal_scaling_lumped<const N: usize>(m: &[[f64; N]; N]) -> [f64; N] {
+    let total: f64 = m.iter().flatten().sum();
+    let trace: f64 = (0..N).map(|a| m[a][a]).sum();
+    std::array::from_fn(|a| m[a][a] * (total / trace))
 }
 
 /// Shape functions N_a and their natural derivatives ∂N_a/∂ξ at one point, one entry per

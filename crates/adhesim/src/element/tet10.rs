@@ -14,7 +14,7 @@ use super::face::{
     gauss_newton_projection, onto_triangle, triangle_quadrature, FaceProjection, FaceType,
     LocalFace,
 };
-use super::{DegenerateElement, Element, ElementType, GaussPoint, Stabilisation};
+use super::{DegenerateElement, Element, ElementType, GaussPoint, Lumping, Stabilisation};
 use crate::Vec3;
 
 /// The six-node triangular face of the tet10: corners counter-clockwise seen from outside,
@@ -103,6 +103,8 @@ const GAUSS_B: f64 = 0.138_196_601_125_010_5;
 impl Element<10, 4> for Tet10 {
     const TYPE: &'static ElementType = &TET10;
     const STABILISATION: Stabilisation = Stabilisation::FBar;
+    /// The row sums would give the corners −ρV/20 each.
+    const LUMPING: Lumping = Lumping::DiagonalScaling;
 
     fn shape(xi: [f64; 3]) -> ([f64; 10], [[f64; 3]; 10]) {
         tet10_shape(xi)

@@ -17,10 +17,10 @@
 //!
 //! Element types: the volume types of the element-type table
 //! ([`crate::element::ELEMENT_TYPES`], found by their Gmsh type number: hex8 (Gmsh type 5),
-//! tet4 (4), tet10 (11) and hex20 (17)) become cells, their nodes taken in the order of the
-//! row's `gmsh_nodes` (Gmsh's order is adhesim's (VTK) order for hex8 and tet4; it differs
-//! in the mid-edge nodes of tet10 and hex20); quad4 (3), tri3 (2), tri6 (9) and quad8 (16)
-//! are faces; points (15) and lines (1, 8, 26, 27, 28) only feed node sets. Other volume or
+//! tet4 (4), tet10 (11), hex20 (17) and hex27 (12)) become cells, their nodes taken in the
+//! order of the row's `gmsh_nodes` (Gmsh's order is adhesim's (VTK) order for hex8 and tet4;
+//! it differs in the mid-edge nodes of tet10, hex20 and hex27 and the face nodes of hex27);
+//! quad4 (3), tri3 (2), tri6 (9), quad8 (16) and quad9 (10) are faces; points (15) and lines (1, 8, 26, 27, 28) only feed node sets. Other volume or
 //! surface elements are rejected, and so is a file mixing first- and second-order volumes.
 
 use super::{Face, Mesh};
@@ -899,11 +899,11 @@ impl Parser<'_> {
                     )
                 } else if dim == 3 {
                     format!(
-                        "the volume elements adhesim reads are {}: remesh with first-order elements (Mesh.ElementOrder = 1), or at second order with Mesh.ElementOrder = 2 and Mesh.SecondOrderIncomplete = 1 (tet10, or 20-node hexahedra without the face and centre nodes)",
+                        "the volume elements adhesim reads are {}: remesh with first-order elements (Mesh.ElementOrder = 1), or at second order with Mesh.ElementOrder = 2 (tet10, hex27; with Mesh.SecondOrderIncomplete = 1, hex20)",
                         volume_type_names(", ")
                     )
                 } else {
-                    format!("adhesim reads {} surface elements: remesh with first-order elements (Mesh.ElementOrder = 1), or at second order with Mesh.SecondOrderIncomplete = 1 (tet10 with tri6 faces, hex20 with quad8 faces)", face_type_names(" and ", false))
+                    format!("adhesim reads {} surface elements: remesh with first-order elements (Mesh.ElementOrder = 1), or at second order (tet10 with tri6 faces, hex27 with quad9 faces; with Mesh.SecondOrderIncomplete = 1, hex20 with quad8 faces)", face_type_names(" and ", false))
                 };
                 return Err(self.err_at(
                     at_type,
@@ -1376,10 +1376,11 @@ $EndElements
         let e = parse_str(&CUBE.replace("1 1 0\n0 1 0", "1 1 0\n0 nan 0")).unwrap_err();
         assert_eq!(e.location, Some(Location::Line(28)), "{e}");
         assert!(e.to_string().starts_with("cube.msh:28: "), "{e}");
-        let e = parse_str(&CUBE.replace("3 1 5 1", "3 1 12 1")).unwrap_err();
+        let e = parse_str(&CUBE.replace("3 1 5 1", "3 1 13 1")).unwrap_err();
         assert!(
-            e.message.contains("hex27 (Gmsh type 12) is not supported")
-                && e.message.contains("SecondOrderIncomplete"),
+            e.message
+                .contains("prism18 (Gmsh type 13) is not supported")
+                && e.message.contains("remesh with hexahedra or tetrahedra"),
             "{e}"
         );
         let e = parse_str(&CUBE.replace("1 2 3 4 5 6 7 8\n", "1 2 3 4 5 6 7 9\n")).unwrap_err();

@@ -20,8 +20,8 @@ use std::collections::BTreeMap;
 
 use crate::element::face::MAX_FACE_NODES;
 use crate::element::{
-    ElementType, FaceType, LocalFace, HEX20, HEX20_EDGES, HEX8, QUAD4, QUAD8, TET10, TET10_EDGES,
-    TET4, TRI3, TRI6,
+    ElementType, FaceType, LocalFace, HEX20, HEX20_EDGES, HEX27, HEX8, QUAD4, QUAD8, QUAD9, TET10,
+    TET10_EDGES, TET4, TRI3, TRI6,
 };
 
 pub mod generate;
@@ -415,6 +415,94 @@ impl Mesh {
                 })
                 .collect();
             out.face_sets.insert(name.clone(), quadratic);
+        }
+        out
+    }
+}
+
+impl Mesh {
+    /// The same body with each hex20 cell made a hex27: a node at the centre of every face
+    /// (shared by the two cells on it) and one at the centre of each cell, placed where the
+    /// hex20's own interpolation puts those points (on a straight-sided cell, the mean of the
+    /// face's or the cell's corners), so the geometry does not change. Face sets of eight-node
+    /// quadrilaterals become nine-node ones; node sets take the face centres of faces whose
+    /// corners are all in the set. Other cells are kept.
+    pub fn with_face_and_centre_nodes(&self) -> Mesh {
+        let mut out = Mesh {
+            nodes: self.nodes.clone(),
+            ..Default::default()
+        };
+        // Face centres by the face's sorted corners; the quad8 interpolation at (0, 0):
+        // −¼ Σ corners + ½ Σ mid-side nodes.
+        let mut centre: std::collections::HashMap<Vec<usize>, usize> =
+            std::collections::HashMap::new();
+        let mut centre_of = |f: &[usize], nodes: &mut Vec<[f64; 3]>| -> usize {
+            let mut key = f[..4].to_vec();
+            key.sort_unstable();
+            *centre.entry(key).or_insert_with(|| {
+                let x: [f64; 3] = std::array::from_fn(|k| {
+                    f[..4].iter().map(|&n| -0.25 * nodes[n][k]).sum::<f64>()
+                        + f[4..8].iter().map(|&n| 0.5 * nodes[n][k]).sum::<f64>()
+                });
+                nodes.push(x);
+                nodes.len() - 1
+            })
+        };
+        for block in &self.blocks {
+            if *block.element != HEX20 {
+                out.connectivity_mut(block.element)
+                    .extend_from_slice(&block.connectivity);
+                continue;
+            }
+            let mut cells = Vec::with_capacity(block.len() * 27);
+            for c in block.cells() {
+                cells.extend_from_slice(c);
+                // Face centres in the hex27's order: ξ = −1, +1, η = −1, +1, ζ = −1, +1.
+                for face in [4, 5, 2, 3, 0, 1] {
+                    let local = HEX27.faces[face].nodes;
+                    let f: Vec<usize> = local[..8].iter().map(|&a| c[a]).collect();
+                    let m = centre_of(&f, &mut out.nodes);
+                    cells.push(m);
+                }
+                // The cell's centre: the hex20 interpolation at 0, −¼ Σ corners + ¼ Σ mids.
+                let x: [f64; 3] = std::array::from_fn(|k| {
+                    c[..8].iter().map(|&n| -0.25 * out.nodes[n][k]).sum::<f64>()
+                        + c[8..20]
+                            .iter()
+                            .map(|&n| 0.25 * out.nodes[n][k])
+                            .sum::<f64>()
+                });
+                out.nodes.push(x);
+                cells.push(out.nodes.len() - 1);
+            }
+            out.connectivity_mut(&HEX27).extend(cells);
+        }
+        for (name, ids) in &self.node_sets {
+            let inside: std::collections::HashSet<usize> = ids.iter().copied().collect();
+            let mut with_centres = ids.clone();
+            with_centres.extend(
+                centre
+                    .iter()
+                    .filter(|(corners, _)| corners.iter().all(|c| inside.contains(c)))
+                    .map(|(_, &m)| m),
+            );
+            out.set_nodes(name, with_centres);
+        }
+        for (name, faces) in &self.face_sets {
+            let faces = faces
+                .iter()
+                .map(|f| {
+                    if *f.face_type() != QUAD8 {
+                        return *f;
+                    }
+                    let mut key = f.corners().to_vec();
+                    key.sort_unstable();
+                    let mut nodes = f.nodes().to_vec();
+                    nodes.push(centre[&key]);
+                    Face::new(&QUAD9, &nodes)
+                })
+                .collect();
+            out.face_sets.insert(name.clone(), faces);
         }
         out
     }

@@ -140,17 +140,19 @@ fn check_face(
 }
 
 /// True if `b` lists the same face as `a` with the same orientation: the same cyclic
-/// sequence of corners, and for a quadratic face the mid-side nodes turned with them.
+/// sequence of corners, for a quadratic face the mid-side nodes turned with them, and a
+/// centre node (quad9) in its place.
 fn same_cycle(face_a: &Face, face_b: &Face) -> bool {
     let (a, b) = (face_a.nodes(), face_b.nodes());
     if face_a.face_type() != face_b.face_type() {
         return false;
     }
     let n = face_a.corners().len();
-    let mids = a.len() - n;
+    let mids = (a.len() - n).min(n);
     (0..n).any(|shift| {
         (0..n).all(|k| a[k] == b[(k + shift) % n])
             && (0..mids).all(|k| a[n + k] == b[n + (k + shift) % n])
+            && (n + mids..a.len()).all(|k| a[k] == b[k])
     })
 }
 
