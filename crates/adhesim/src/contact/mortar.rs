@@ -8,18 +8,28 @@
 //! exact for the products of bilinear shape functions on parallelograms. Slave node j then
 //! holds
 //!
-//! - C_j = ∫ N_j dA over the covered part of its faces (the mortar measure),
-//! - M_jl = ∫ N_j N_l dA for each master node l,
+//! - C_j = ∫ φ_j dA over the covered part of its faces (the mortar measure),
+//! - M_jl = ∫ ψ_j N_l dA for each master node l,
+//! - D_jk = ∫ ψ_j N_k dA for each slave node k,
 //!
-//! and one contact site: the N_j-weighted mean of the slave surface (slave nodes k with
-//! weights D_jk / C_j, D_jk = ∫ N_j N_k dA over the covered part) against the N_j-weighted
-//! mean of the master surface (master nodes l with weights M_jl / C_j). Both sets of weights
-//! are positive and add up to 1, a uniform pressure p gives the nodal forces p ∫ N_k on the
-//! slave side and p ∫ N_l on the master side (the consistent forces of that pressure, which is
-//! what passes the contact patch test on non-matching meshes), and two surfaces that stretch
-//! together have no relative slip (the two means move alike). The site is keyed by its slave
-//! node j; its area is C_j in the reference configuration (the covered measure scaled by each
-//! face's reference-to-current area ratio), so tractions stay nominal as with node-to-surface.
+//! with φ_j its weight on each flat piece of its faces (the face's own shape function on a
+//! linear face) and ψ_j its multiplier function there: on a linear face covered by the master
+//! surface the dual (biorthogonal) multiplier ψ_j = Σ_k a_jk φ_k with ∫ ψ_j φ_k = δ_jk ∫ φ_j
+//! over the face ([`dual_coefficients`]), so that D_jk = δ_jk C_j; on a face the master covers
+//! only in part, and on the flat pieces of quadratic faces, ψ_j = φ_j (standard multipliers).
+//! Its contact site is the D_jk / C_j-weighted slave nodes (the node alone where its faces
+//! are covered) against the M_jl / C_j-weighted master nodes: both sets of weights add up to
+//! 1 (the master's may be negative), a uniform pressure p gives the nodal forces p ∫ N_k on
+//! the slave side and p ∫ N_l on the master side (the consistent forces of that pressure,
+//! which is what passes the contact patch test on non-matching meshes), and two surfaces that
+//! stretch together have no relative slip (both weightings reproduce linear fields). The site
+//! is keyed by its slave node j; its area is C_j in the reference configuration (the covered
+//! measure scaled by each face's reference-to-current area ratio), so tractions stay nominal
+//! as with node-to-surface.
+//!
+//! Dual multipliers keep a site's stencil to its node and the master nodes it overlaps (9 to
+//! 16 on regular meshes) instead of the 9 slave nodes of its faces as well: the semismooth
+//! solve's factorisations fill in less (docs/contact-surfaces.md, *Cost*).
 //!
 //! Self-contact is the same: the slave and master faces are of one body (one face set, or
 //! two); a face sharing a node with a slave face (its neighbour on the surface) is left out
