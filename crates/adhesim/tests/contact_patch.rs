@@ -8,7 +8,8 @@
 //! pressure uniform to 1e-6 relative and force to 1e-8. The Newton and contact tolerances are
 //! 1e-12, far below these, except for the augmented-Lagrangian solve (`newton`), whose
 //! multiplier ρ of a thousand times the stiffness at a point leaves a round-off floor near
-//! 1e-9: it runs at 1e-8 (its force then comes out within 1e-10). Node-to-surface contact,
+//! 1e-9: it runs at 1e-9 (its force then comes out within 2e-10; at 1e-8 the force is within
+//! that tolerance, 1.03e-8 on the matching meshes with dual multipliers). Node-to-surface contact,
 //! shown beside it, passes only on matching meshes.
 //!
 //! The same test with both blocks of second-order tetrahedra (six-node triangle faces):
@@ -23,7 +24,7 @@ use std::sync::Arc;
 const PRESSURE: f64 = 1000.0;
 
 fn scenario(slave: usize, master: usize, discretisation: &str, solver: &str) -> String {
-    let tol = if solver == "newton" { 1e-8 } else { 1e-12 };
+    let tol = if solver == "newton" { 1e-9 } else { 1e-12 };
     format!(
         r#"
 [time]

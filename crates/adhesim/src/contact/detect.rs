@@ -232,9 +232,10 @@ pub struct ContactPoint {
     /// among them, and its area is theirs together, so that the slab cannot be twisted out
     /// of its plane by contact.
     pub twins: Vec<(usize, usize)>,
-    /// The slave side's own weights (global node, weight; adding up to 1) when the point's
-    /// slave displacement is a weighted mean of several slave nodes (mortar); empty for the
-    /// node alone or with its twins.
+    /// The slave side's own weights (global node, weight; adding up to 1) of a mortar site:
+    /// its node alone (weight 1) where dual multipliers are used, a weighted mean of several
+    /// slave nodes otherwise; empty for a node-to-surface site (the node alone or with its
+    /// twins).
     pub slave_weights: Vec<(usize, f64)>,
 }
 

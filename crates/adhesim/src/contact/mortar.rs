@@ -8,18 +8,28 @@
 //! exact for the products of bilinear shape functions on parallelograms. Slave node j then
 //! holds
 //!
-//! - C_j = ∫ N_j dA over the covered part of its faces (the mortar measure),
-//! - M_jl = ∫ N_j N_l dA for each master node l,
+//! - C_j = ∫ φ_j dA over the covered part of its faces (the mortar measure),
+//! - M_jl = ∫ ψ_j N_l dA for each master node l,
+//! - D_jk = ∫ ψ_j N_k dA for each slave node k,
 //!
-//! and one contact site: the N_j-weighted mean of the slave surface (slave nodes k with
-//! weights D_jk / C_j, D_jk = ∫ N_j N_k dA over the covered part) against the N_j-weighted
-//! mean of the master surface (master nodes l with weights M_jl / C_j). Both sets of weights
-//! are positive and add up to 1, a uniform pressure p gives the nodal forces p ∫ N_k on the
-//! slave side and p ∫ N_l on the master side (the consistent forces of that pressure, which is
-//! what passes the contact patch test on non-matching meshes), and two surfaces that stretch
-//! together have no relative slip (the two means move alike). The site is keyed by its slave
-//! node j; its area is C_j in the reference configuration (the covered measure scaled by each
-//! face's reference-to-current area ratio), so tractions stay nominal as with node-to-surface.
+//! with φ_j its weight on each flat piece of its faces (the face's own shape function on a
+//! linear face) and ψ_j its multiplier function there: on a linear face covered by the master
+//! surface the dual (biorthogonal) multiplier ψ_j = Σ_k a_jk φ_k with ∫ ψ_j φ_k = δ_jk ∫ φ_j
+//! over the face ([`dual_coefficients`]), so that D_jk = δ_jk C_j; on a face the master covers
+//! only in part, and on the flat pieces of quadratic faces, ψ_j = φ_j (standard multipliers).
+//! Its contact site is the D_jk / C_j-weighted slave nodes (the node alone where its faces
+//! are covered) against the M_jl / C_j-weighted master nodes: both sets of weights add up to
+//! 1 (the master's may be negative), a uniform pressure p gives the nodal forces p ∫ N_k on
+//! the slave side and p ∫ N_l on the master side (the consistent forces of that pressure,
+//! which is what passes the contact patch test on non-matching meshes), and two surfaces that
+//! stretch together have no relative slip (both weightings reproduce linear fields). The site
+//! is keyed by its slave node j; its area is C_j in the reference configuration (the covered
+//! measure scaled by each face's reference-to-current area ratio), so tractions stay nominal
+//! as with node-to-surface.
+//!
+//! Dual multipliers keep a site's stencil to its node and the master nodes it overlaps (9 to
+//! 16 on regular meshes) instead of the 9 slave nodes of its faces as well: the semismooth
+//! solve's factorisations fill in less (docs/contact-surfaces.md, *Cost*).
 //!
 //! Self-contact is the same: the slave and master faces are of one body (one face set, or
 //! two); a face sharing a node with a slave face (its neighbour on the surface) is left out
@@ -274,7 +284,9 @@ impl SlavePiece {
     }
 
     /// Adds this piece's segments with the master `faces` near it to the slave nodes'
-    /// integrals.
+    /// integrals: with the dual multipliers of the piece ([`dual_coefficients`]) when the
+    /// piece is a whole linear face covered by the master surface, with the piece's own
+    /// weights (standard multipliers) otherwise.
     fn integrate(
         &self,
         faces: &[Face],
@@ -284,18 +296,41 @@ impl SlavePiece {
         detection: f64,
         integrals: &mut [NodeIntegrals],
     ) {
-        let own = key(self.nodes.iter().copied());
         let slave_polygon = counter_clockwise(self.corners.clone());
+        let mut area = 0.0;
         for (p, w) in polygon_quadrature(&slave_polygon) {
             let phi = shape_at(&self.corners, p);
             for (c, &at) in self.piece.iter().enumerate() {
                 integrals[self.locals[at]].full += w * phi[c];
             }
+            area += w;
         }
+        let points = self.segment_points(faces, grid, sides, pos, detection, &slave_polygon);
+        let covered: f64 = points.iter().map(|q| q.w).sum();
+        let dual = (self.face_type.piece_is_face(self.piece)
+            && covered >= (1.0 - FULLY_COVERED) * area)
+            .then(|| dual_coefficients(&points))
+            .flatten();
+        for q in &points {
+            self.add_point(q, faces[q.face].nodes(), dual.as_deref(), integrals);
+        }
+    }
+
+    /// The quadrature points of this piece's segments with the master `faces` near it.
+    fn segment_points(
+        &self,
+        faces: &[Face],
+        grid: &FaceGrid,
+        sides: &Sides,
+        pos: &dyn Fn(usize) -> [f64; 3],
+        detection: f64,
+        slave_polygon: &[Point2],
+    ) -> Vec<SegmentPoint> {
+        let own = key(self.nodes.iter().copied());
         let (lo, hi) = self.bounding_box(pos);
+        let mut points = Vec::new();
         for fi in grid.candidates_in_box(lo, hi) {
-            let master_nodes = faces[fi].nodes();
-            if !sides.integrates(&own, &key(master_nodes.iter().copied())) {
+            if !sides.integrates(&own, &key(faces[fi].nodes().iter().copied())) {
                 continue;
             }
             for piece in faces[fi].flat_pieces() {
@@ -303,24 +338,57 @@ impl SlavePiece {
                     continue;
                 };
                 let master_type = faces[fi].face_type();
-                let segment = clip(&slave_polygon, &counter_clockwise(master.clone()));
+                let segment = clip(slave_polygon, &counter_clockwise(master.clone()));
                 if segment.is_empty() {
                     continue;
                 }
                 for (p, w) in polygon_quadrature(&segment) {
-                    let phi = shape_at(&self.corners, p);
-                    let ns = self.face_type.shape_on_piece(self.piece, phi.clone());
-                    let nm = master_type.shape_on_piece(piece, shape_at(&master, p));
-                    for (c, &at) in self.piece.iter().enumerate() {
-                        let node = &mut integrals[self.locals[at]];
-                        node.covered += w * phi[c];
-                        node.nominal += w * phi[c] * self.area_ratio;
-                        for (k, &m) in master_nodes.iter().enumerate() {
-                            *node.master.entry(m).or_insert(0.0) += w * phi[c] * nm[k];
-                        }
-                        for (k, &n) in self.nodes.iter().enumerate() {
-                            *node.slave.entry(n).or_insert(0.0) += w * phi[c] * ns[k];
-                        }
+                    points.push(SegmentPoint {
+                        w,
+                        phi: shape_at(&self.corners, p),
+                        face: fi,
+                        master: master_type.shape_on_piece(piece, shape_at(&master, p)),
+                    });
+                }
+            }
+        }
+        points
+    }
+
+    /// Adds the quadrature point `q` of a segment with a master face of nodes `master_nodes`
+    /// to the integrals of this piece's nodes: C_j, its reference measure, M_jl = ∫ ψ_j N_l
+    /// and D_jk = ∫ ψ_j N_k, with ψ_j the dual multiplier of coefficients `dual` (then
+    /// D_jk = δ_jk C_j), or the piece's own weight of the node when `dual` is `None`.
+    fn add_point(
+        &self,
+        q: &SegmentPoint,
+        master_nodes: &[usize],
+        dual: Option<&[Vec<f64>]>,
+        integrals: &mut [NodeIntegrals],
+    ) {
+        let ns = match dual {
+            Some(_) => Vec::new(),
+            None => self.face_type.shape_on_piece(self.piece, q.phi.clone()),
+        };
+        for (c, &at) in self.piece.iter().enumerate() {
+            let node = &mut integrals[self.locals[at]];
+            let wc = q.w * q.phi[c];
+            node.covered += wc;
+            node.nominal += wc * self.area_ratio;
+            match dual {
+                Some(a) => {
+                    let psi: f64 = a[c].iter().zip(&q.phi).map(|(a, p)| a * p).sum();
+                    for (k, &m) in master_nodes.iter().enumerate() {
+                        *node.master.entry(m).or_insert(0.0) += q.w * psi * q.master[k];
+                    }
+                    *node.slave.entry(self.nodes[at]).or_insert(0.0) += wc;
+                }
+                None => {
+                    for (k, &m) in master_nodes.iter().enumerate() {
+                        *node.master.entry(m).or_insert(0.0) += wc * q.master[k];
+                    }
+                    for (k, &n) in self.nodes.iter().enumerate() {
+                        *node.slave.entry(n).or_insert(0.0) += wc * ns[k];
                     }
                 }
             }
@@ -374,6 +442,48 @@ impl SlavePiece {
         }
         (lo, hi)
     }
+}
+
+/// A slave piece whose covered measure is at least (1 − this) of its area counts as covered
+/// by the master surface (round-off of the clipping aside) and takes dual multipliers.
+const FULLY_COVERED: f64 = 1e-9;
+
+/// A quadrature point of a segment (the overlap of a slave piece and a master piece).
+struct SegmentPoint {
+    /// Weight [m²].
+    w: f64,
+    /// The slave piece's own (linear or bilinear) weights at the point, one per corner.
+    phi: Vec<f64>,
+    /// The master face, by its index in the pair's master faces.
+    face: usize,
+    /// The master face's shape functions at the point, one per node.
+    master: Vec<f64>,
+}
+
+/// The coefficients a_jk of the dual multipliers ψ_j = Σ_k a_jk φ_k of a slave piece with
+/// weights φ over the quadrature points `points` (Popp, Gitterle, Gee and Wall 2010):
+/// biorthogonal to the φ, ∫ ψ_j φ_k dA = δ_jk ∫ φ_j dA, so A = D M⁻¹ with
+/// M_jk = ∫ φ_j φ_k dA and D = diag(∫ φ_j dA), both over the points. `None` when M is
+/// singular. A site's slave side is then its node alone, and its master weights
+/// ∫ ψ_j N_l / ∫ φ_j still add up to 1 but may be negative.
+fn dual_coefficients(points: &[SegmentPoint]) -> Option<Vec<Vec<f64>>> {
+    let n = points.first()?.phi.len();
+    let mut m = nalgebra::DMatrix::<f64>::zeros(n, n);
+    let mut d = vec![0.0; n];
+    for q in points {
+        for j in 0..n {
+            d[j] += q.w * q.phi[j];
+            for k in 0..n {
+                m[(j, k)] += q.w * q.phi[j] * q.phi[k];
+            }
+        }
+    }
+    let inv = m.try_inverse()?;
+    Some(
+        (0..n)
+            .map(|j| (0..n).map(|k| d[j] * inv[(j, k)]).collect())
+            .collect(),
+    )
 }
 
 /// Twice the area vector of a face with corners `x` (three or four): the cross product of
@@ -523,13 +633,15 @@ mod tests {
                     "{} vs {expected}",
                     s.area
                 );
-                // Master weights: positive and a partition of unity, so the master point
-                // (the N_j-weighted mean of the covered master surface) lies on the flat
-                // master and the normal gap is exact; its tangential offset from the slave
-                // node is constant over the step and leaves the slip increments unchanged.
-                assert!(s.master.iter().all(|&(_, w)| w > 0.0));
+                // The slave surface is covered: dual multipliers, the slave side is the
+                // node alone. The master weights are a partition of unity (some negative)
+                // that reproduces linear fields, so the master point is the slave node's
+                // own projection on the flat master: the normal gap is exact and there is no
+                // tangential offset.
+                assert_eq!(s.slave_weights, vec![(s.slave, 1.0)]);
                 assert!((s.master.iter().map(|m| m.1).sum::<f64>() - 1.0).abs() < 1e-13);
                 assert!(s.master_point_end[2].abs() < 1e-15);
+                assert!(s.d0[0].abs() < 1e-13 && s.d0[1].abs() < 1e-13, "{:?}", s.d0);
                 assert!((s.d0[2] - 0.01).abs() < 1e-15 && s.frame[2][2] > 0.999_999);
             }
             // Each master node's share of a uniform pressure, Σ_j C_j w_jl, is ∫ N_l over
@@ -550,6 +662,67 @@ mod tests {
                     (a - expected).abs() < 1e-13,
                     "master {l}: {a} vs {expected}"
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn dual_multipliers_are_biorthogonal_to_the_piece_weights() {
+        // A distorted quadrilateral and a triangle, integrated over themselves.
+        let quad = vec![[0.0, 0.0], [1.2, 0.1], [1.0, 0.9], [-0.1, 1.1]];
+        let tri = vec![[0.0, 0.0], [1.0, 0.2], [0.3, 0.8]];
+        for corners in [quad, tri] {
+            let points: Vec<SegmentPoint> = polygon_quadrature(&corners)
+                .into_iter()
+                .map(|(p, w)| SegmentPoint {
+                    w,
+                    phi: shape_at(&corners, p),
+                    face: 0,
+                    master: Vec::new(),
+                })
+                .collect();
+            let a = dual_coefficients(&points).unwrap();
+            let n = corners.len();
+            for j in 0..n {
+                let integral = |f: &dyn Fn(&SegmentPoint) -> f64| -> f64 {
+                    points.iter().map(|q| q.w * f(q)).sum()
+                };
+                let psi = |q: &SegmentPoint| -> f64 { (0..n).map(|k| a[j][k] * q.phi[k]).sum() };
+                let measure = integral(&|q| q.phi[j]);
+                for k in 0..n {
+                    let product = integral(&|q| psi(q) * q.phi[k]);
+                    let expected = if j == k { measure } else { 0.0 };
+                    assert!((product - expected).abs() < 1e-14, "{j} {k}: {product}");
+                }
+                // ∫ ψ_j = ∫ φ_j: the site's measure is unchanged.
+                assert!((integral(&psi) - measure).abs() < 1e-14);
+            }
+        }
+    }
+
+    #[test]
+    fn a_slave_face_partly_covered_keeps_the_standard_multipliers() {
+        // The master covers [0, 1]²; the slave grid is shifted by half a face along x.
+        let (pair, mut coords) = flat_pair([4, 4], [3, 3], 0.01);
+        for c in coords.iter_mut().filter(|c| c[2] > 0.0) {
+            c[0] += 0.125;
+        }
+        let u0 = vec![0.0; 3 * coords.len()];
+        let sites = Mortar.sites(0, &pair, &coords, &u0, 0.0, 1.0);
+        for s in &sites {
+            let x = coords[s.slave][0];
+            let positive = s.master.iter().all(|&(_, w)| w > 0.0);
+            let sum = |w: &[(usize, f64)]| w.iter().map(|m| m.1).sum::<f64>();
+            assert!(
+                (sum(&s.master) - 1.0).abs() < 1e-13 && (sum(&s.slave_weights) - 1.0).abs() < 1e-13
+            );
+            if x > 1.0 {
+                // Its faces reach beyond the master: standard weights, all positive.
+                assert!(positive && s.slave_weights.len() > 1, "{x}: {s:?}");
+            } else if x < 0.8 {
+                // Its faces are covered: dual multipliers (the node at x = 0.875 has one
+                // face of each kind).
+                assert_eq!(s.slave_weights, vec![(s.slave, 1.0)]);
             }
         }
     }

@@ -18,7 +18,8 @@ pub const RHO_FACTOR: f64 = 1000.0;
 /// - A node-to-surface site (one slave node, or a plane-strain line of them, against a face's
 ///   nodes): 1/(Σ_n w_n²/k_n), the nodes taken as independent springs, an upper bound
 ///   since 1/(e K̄⁻¹ e) ≤ e K̄ e along any unit direction e.
-/// - A mortar site (each side the weighted mean of a patch of neighbouring nodes): the nodes
+/// - A mortar site (each side the weighted mean of a patch of neighbouring nodes, the slave
+///   side its node alone with dual multipliers): the nodes
 ///   of a patch move together, so each side is one spring of compliance (Σ_n |w_n|/√k_n)²
 ///   and the site 1/Σ_sides. The independent-spring bound would be several times too stiff
 ///   here (by about half the nodes of a patch), and a ρ that large makes the semismooth
