@@ -283,9 +283,9 @@ pub struct Stepper {
     mixed_workspace: MixedWorkspace,
     /// What the latest attempt was.
     last_attempt: AttemptKind,
-    /// Set when a step on which `auto` chose the augmented-Lagrangian contact solve failed:
-    /// `auto` no longer chooses it in this run.
-    auto_without_newton_contact: bool,
+    /// The run's contact solver: the scenario's, until a step on which `auto` chose the
+    /// augmented-Lagrangian solve fails; then `AutoWithoutNewton` for the rest of the run.
+    contact_solver: ContactSolver,
     /// Nodal reaction forces of the last committed step [N] (see [`Stepper::reactions`]).
     reactions: Vec<f64>,
     /// Buffers of the Newton loop.
@@ -326,6 +326,7 @@ impl Stepper {
         };
         let mut s = Stepper {
             dt: problem.time.dt,
+            contact_solver: problem.time.contact_solver,
             problem,
             disc,
             state,
@@ -343,7 +344,6 @@ impl Stepper {
             delassus_cache: None,
             mixed_workspace: MixedWorkspace::default(),
             last_attempt: AttemptKind::default(),
-            auto_without_newton_contact: false,
             reactions: vec![0.0; n],
             workspace: Workspace::default(),
         };
@@ -650,12 +650,7 @@ impl Stepper {
     /// iteration) before the caller cuts Δt back, so that keeping factorisations never
     /// fails a step full Newton solves.
     fn attempt_with_fallback(&mut self, dt: f64) -> Result<Attempt, String> {
-        let (method, configured) = (self.problem.time.newton, self.problem.time.contact_solver);
-        let solver = if self.auto_without_newton_contact {
-            ContactSolver::AutoWithoutNewton
-        } else {
-            configured
-        };
+        let (method, solver) = (self.problem.time.newton, self.contact_solver);
         let mut result = self.attempt(dt, method, solver);
         if result.is_err() && self.last_attempt.method != NewtonMethod::Full {
             result = self.attempt(dt, NewtonMethod::Full, solver);
@@ -674,7 +669,7 @@ impl Stepper {
             // The augmented-Lagrangian solve `auto` chose failed: this step and the rest of
             // the run with the semismooth solve (and Gauss-Seidel below its threshold).
             ContactSolver::Newton => {
-                self.auto_without_newton_contact = true;
+                self.contact_solver = ContactSolver::AutoWithoutNewton;
                 self.attempt_with_fallback(dt).map_err(|again| {
                     format!("{reason}; again without the augmented Lagrangian: {again}")
                 })
