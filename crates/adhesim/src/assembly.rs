@@ -650,13 +650,27 @@ impl Discretisation {
 
     /// Internal force, and the tangent when `with_tangent`, at global displacement `u`.
     pub fn assemble(&self, u: &[f64], with_tangent: bool) -> Assembled {
+        self.assemble_reusing(u, with_tangent, Vec::new())
+    }
+
+    /// As [`Self::assemble`], writing the tangent into `tangent_buffer` (any length; it is
+    /// resized and zeroed). A Newton loop hands back the previous iteration's tangent so
+    /// that the largest array of an assembly is not allocated afresh each time: a new one
+    /// is mapped zero pages, each page's first write a fault (at 10⁴ contact nodes of the
+    /// scale pad a quarter of the run's time went to them).
+    pub fn assemble_reusing(
+        &self,
+        u: &[f64],
+        with_tangent: bool,
+        mut tangent_buffer: Vec<f64>,
+    ) -> Assembled {
+        tangent_buffer.clear();
+        if with_tangent {
+            tangent_buffer.resize(self.pattern.nnz(), 0.0);
+        }
         let mut out = Assembled {
             force: vec![0.0; self.num_dofs()],
-            tangent: if with_tangent {
-                vec![0.0; self.pattern.nnz()]
-            } else {
-                Vec::new()
-            },
+            tangent: tangent_buffer,
             energy: 0.0,
             min_j: f64::INFINITY,
         };

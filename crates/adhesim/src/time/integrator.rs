@@ -22,6 +22,8 @@ pub struct Workspace {
     pub v1: Vec<f64>,
     tmp: Vec<f64>,
     acc: Vec<f64>,
+    /// The last assembled tangent's values, kept for the next assembly to write into.
+    pub tangent: Vec<f64>,
 }
 
 impl Workspace {

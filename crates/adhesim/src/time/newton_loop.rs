@@ -100,7 +100,20 @@ impl<'a> NewtonLoop<'a> {
     /// law, check convergence, factorise K̄ and solve the correction, solve the contact
     /// problem, update `u`.
     pub fn iterate(&mut self, iter: usize, u: &mut [f64]) -> Result<Flow, String> {
-        let asm = assemble(self.disc, u, iter, &mut self.timings)?;
+        let buffer = std::mem::take(&mut self.ws.tangent);
+        let mut asm = assemble(self.disc, u, iter, buffer, &mut self.timings)?;
+        let flow = self.iterate_assembled(iter, u, &mut asm);
+        self.ws.tangent = std::mem::take(&mut asm.tangent);
+        flow
+    }
+
+    /// The rest of Newton iteration `iter` once `asm` holds the iterate's force and tangent.
+    fn iterate_assembled(
+        &mut self,
+        iter: usize,
+        u: &mut [f64],
+        asm: &mut Assembled,
+    ) -> Result<Flow, String> {
         let balance = self.step.balance(u, &asm.force, asm.energy, self.ws);
         if iter == 1 {
             let step = &self.step;
@@ -234,7 +247,7 @@ impl<'a> NewtonLoop<'a> {
 
     /// Stage *commit* (what the step hands back): the converged iterate `u` with its end
     /// velocity, work, forces and contact solution.
-    fn finish(&mut self, u: &[f64], asm: Assembled, check: Check) -> Attempt {
+    fn finish(&mut self, u: &[f64], asm: &mut Assembled, check: Check) -> Attempt {
         let (points, history0) = self.coupling.step_contact().take_candidates();
         let force = self.coupling.contact_force();
         Attempt {
@@ -242,7 +255,7 @@ impl<'a> NewtonLoop<'a> {
             v: self.step.end_velocity(u, &self.ws.v1),
             f_ext1: self.step.f_ext1.clone(),
             u: u.to_vec(),
-            f_int1: asm.force,
+            f_int1: std::mem::take(&mut asm.force),
             iterations: check.iter - 1,
             residual: check.relative,
             internal: asm.energy,
@@ -265,10 +278,11 @@ fn assemble(
     disc: &Discretisation,
     u: &[f64],
     iter: usize,
+    tangent_buffer: Vec<f64>,
     timings: &mut PhaseTimes,
 ) -> Result<Assembled, String> {
     let clock = Instant::now();
-    let asm = disc.assemble(u, true);
+    let asm = disc.assemble_reusing(u, true, tangent_buffer);
     timings.assembly += clock.elapsed().as_secs_f64();
     if asm.min_j.is_nan() || asm.min_j <= 0.0 || !asm.energy.is_finite() {
         return Err(format!(
