@@ -7,6 +7,9 @@
 //!   the element-constant and with the linear volume change;
 //! - a Gmsh file of hex27 and quad9 written by Gmsh 4.15 (tests/data/box_hex27.py): nodes in
 //!   their places, volume, face sets;
+//! - a Gmsh quarter of a thick tube (tests/data/quarter_tube_hex27.py, two meshes): the
+//!   curved faces' nodes on their cylinders, the volume against the closed form of its
+//!   parabolic arcs and the tube's, and Lamé's radial displacement under internal pressure;
 //! - node-to-surface contact between two bodies on its nine-node faces is refused, naming
 //!   mortar (tests/contact_patch.rs runs the contact patch test on them);
 //! - the square cantilever (ν = 0.3) at 1 and 2 layers, and the plane-strain one at
