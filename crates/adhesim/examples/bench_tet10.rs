@@ -13,16 +13,23 @@
 //!    points), standard and `Formulation::FBar` (on a hex20 the linear volume change,
 //!    Q2/P1), against hex8;
 //! 4. one hex20 element's response with tangent: the linear volume change (Q2/P1) against
-//!    the standard element and against the element-constant one (F-bar, Q2/P0) (µs).
+//!    the standard element and against the element-constant one (F-bar, Q2/P0) (µs);
+//! 5. the 27-node hexahedron (hex27, 27 Gauss points) against the hex20 and the hex8: one
+//!    element's response with tangent (standard), and the assembly per element of the cube's
+//!    n³ cells, standard and `Formulation::FBar` (the linear volume change on hex20 and hex27,
+//!    the element-constant one on hex8).
 //!
-//! Each pair (hex8, tet10 or hex20) is timed alternately after one warm-up run of each, so that both
-//! see the same machine load; reported are the median of each and the median of the
-//! per-pair ratios. Usage: `cargo run --release --example bench_tet10 -- [n] [reps]`.
+//! Each pair (hex8, tet10 or hex20; hex27 against hex8, and against hex20) is timed
+//! alternately after one warm-up run of each, so that both see the same machine load;
+//! reported are the median of each and the median of the per-pair ratios. Usage:
+//! `cargo run --release --example bench_tet10 -- [n] [reps] [hex27]`; with `hex27` only
+//! item 5 runs.
 
 use adhesim::assembly::Discretisation;
 use adhesim::dilatation::{linear_dilatation_response, LinearDilatation};
 use adhesim::element::{
-    element_response, hex20_geometry, hex8_geometry, tet10_geometry, HEX20, TET10,
+    element_response, hex20_geometry, hex27_geometry, hex8_geometry, tet10_geometry, HEX20, HEX27,
+    TET10,
 };
 use adhesim::fbar::{fbar_element_response, Formulation};
 use adhesim::material::{Hyperelastic, UncoupledNeoHookean};
@@ -75,11 +82,19 @@ fn main() {
     let material: Arc<dyn Hyperelastic> =
         Arc::new(UncoupledNeoHookean::from_young_poisson(1.0e6, 0.4999));
     let mat = &*material;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("thread pool");
 
     // 1. One element of each, in the same cube cell.
     let mesh = generate::block([1.0, 1.0, 1.0], [n, n, n]);
-    let tet10 = mesh.split_hexes_into_tets().with_mid_side_nodes();
     let hex20 = mesh.with_mid_side_nodes();
+    if args.get(2).map(String::as_str) == Some("hex27") {
+        hex27_cost(&mesh, &hex20, &material, reps, &pool);
+        return;
+    }
+    let tet10 = mesh.split_hexes_into_tets().with_mid_side_nodes();
     let hex = mesh.hexes()[0];
     let xh: [[f64; 3]; 8] = hex.map(|a| mesh.nodes[a]);
     let gh = hex8_geometry(&xh).expect("valid element");
@@ -105,10 +120,6 @@ fn main() {
     let (hex_el, tet_el) = (hex_el / iters as f64, tet_el / iters as f64);
 
     // 2. Assembly on one thread.
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .expect("thread pool");
     let uh: Vec<f64> = mesh.nodes.iter().flat_map(|&p| displacement(p)).collect();
     let ut: Vec<f64> = tet10.nodes.iter().flat_map(|&p| displacement(p)).collect();
     let nh = mesh.hexes().len() as f64;
@@ -165,6 +176,124 @@ fn main() {
     }
     hex20_assembly(&mesh, &hex20, &material, reps, &pool);
     hex20_kernels(&hex20, mat, reps);
+    hex27_cost(&mesh, &hex20, &material, reps, &pool);
+}
+
+/// Item 5: the hex27 against the hex20 and the hex8, one element's response with tangent and
+/// the assembly per element of the cube's n³ cells, each pair timed alternately.
+fn hex27_cost(
+    mesh: &adhesim::mesh::Mesh,
+    hex20: &adhesim::mesh::Mesh,
+    material: &Arc<dyn Hyperelastic>,
+    reps: usize,
+    pool: &rayon::ThreadPool,
+) {
+    let mat = &**material;
+    let hex27 = hex20.with_face_and_centre_nodes();
+    let x8: [[f64; 3]; 8] = mesh.hexes()[0].map(|a| mesh.nodes[a]);
+    let x20: [[f64; 3]; 20] = hex20.cells_of::<20>(&HEX20)[0].map(|a| hex20.nodes[a]);
+    let x27: [[f64; 3]; 27] = hex27.cells_of::<27>(&HEX27)[0].map(|a| hex27.nodes[a]);
+    let (g8, g20, g27) = (
+        hex8_geometry(&x8).expect("valid element"),
+        hex20_geometry(&x20).expect("valid element"),
+        hex27_geometry(&x27).expect("valid element"),
+    );
+    let (u8, u20, u27) = (
+        x8.map(displacement),
+        x20.map(displacement),
+        x27.map(displacement),
+    );
+    let iters = 2_000;
+    let per = |t: f64| t / iters as f64 * 1e6;
+    let e8 = || {
+        for _ in 0..iters {
+            black_box(element_response(black_box(&g8), black_box(&u8), mat, true));
+        }
+    };
+    let e20 = || {
+        for _ in 0..iters {
+            black_box(element_response(
+                black_box(&g20),
+                black_box(&u20),
+                mat,
+                true,
+            ));
+        }
+    };
+    let e27 = || {
+        for _ in 0..iters {
+            black_box(element_response(
+                black_box(&g27),
+                black_box(&u27),
+                mat,
+                true,
+            ));
+        }
+    };
+    let (t8, t27a, r8) = alternate(reps, e8, e27);
+    let (t20, t27b, r20) = alternate(reps, e20, e27);
+    let cells = mesh.hexes().len() as f64;
+    println!();
+    println!(
+        "{n}³ cube: {cells} cells; hex8 {} nodes, hex20 {}, hex27 {}; one thread, {reps} \
+         alternating pairs",
+        mesh.num_nodes(),
+        hex20.num_nodes(),
+        hex27.num_nodes(),
+        n = (cells.cbrt()).round()
+    );
+    println!();
+    println!("| measurement | hex8 [µs] | hex20 [µs] | hex27 [µs] (against hex8 / against hex20) | hex27/hex8 | hex27/hex20 |");
+    println!("|---|---|---|---|---|---|");
+    println!(
+        "| one element's response with tangent, standard | {:.2} | {:.2} | {:.2} / {:.2} | {r8:.2} | {r20:.2} |",
+        per(t8),
+        per(t20),
+        per(t27a),
+        per(t27b)
+    );
+    let u_of = |m: &adhesim::mesh::Mesh| -> Vec<f64> {
+        m.nodes.iter().flat_map(|&p| displacement(p)).collect()
+    };
+    let (uh, uq, ut) = (u_of(mesh), u_of(hex20), u_of(&hex27));
+    for (name, f) in [
+        ("standard", Formulation::Standard),
+        ("F-bar (linear θ on hex20 and hex27)", Formulation::FBar),
+    ] {
+        let d = |m: &adhesim::mesh::Mesh| {
+            Discretisation::with_formulations(&[(m, material.clone())], &[f]).expect("valid mesh")
+        };
+        let (d8, d20, d27) = (d(mesh), d(hex20), d(&hex27));
+        let ((t8, t27a, r8), (t20, t27b, r20)) = pool.install(|| {
+            (
+                alternate(
+                    reps,
+                    || drop(black_box(d8.assemble(black_box(&uh), true))),
+                    || drop(black_box(d27.assemble(black_box(&ut), true))),
+                ),
+                alternate(
+                    reps,
+                    || drop(black_box(d20.assemble(black_box(&uq), true))),
+                    || drop(black_box(d27.assemble(black_box(&ut), true))),
+                ),
+            )
+        });
+        println!(
+            "| assembly K + f per element, {name} | {:.2} | {:.2} | {:.2} / {:.2} | {r8:.2} | {r20:.2} |",
+            t8 / cells * 1e6,
+            t20 / cells * 1e6,
+            t27a / cells * 1e6,
+            t27b / cells * 1e6
+        );
+        println!(
+            "| stored tangent values, {name} | {} | {} | {} | {:.2} | {:.2} |",
+            d8.pattern.nnz(),
+            d20.pattern.nnz(),
+            d27.pattern.nnz(),
+            d27.pattern.nnz() as f64 / d8.pattern.nnz() as f64,
+            d27.pattern.nnz() as f64 / d20.pattern.nnz() as f64
+        );
+    }
 }
 
 /// Item 4: one hex20's response with tangent, the linear volume change against the standard
