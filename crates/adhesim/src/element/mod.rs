@@ -44,7 +44,6 @@ pub use tet4::{tet4_geometry, tet4_shape, Tet4, TET4, TRI3};
 
 use crate::material::Hyperelastic;
 use crate::{Mat3, Vec3};
-use nalgebra::SMatrix;
 
 /// The table of element types: each entry is an element's Rust type with its node and
 /// Gauss-point counts, and its [`ElementType`] row. It defines [`ELEMENT_TYPES`] and
@@ -336,20 +335,84 @@ pub struct ElementResponse<const N: usize> {
     pub min_j: f64,
 }
 
-type Bmat = SMatrix<f64, 6, 3>;
+/// A 3×3×3×3 tensor, `t[i][k][J][L]`.
+type Tensor4 = [[[[f64; 3]; 3]; 3]; 3];
 
+/// Voigt index of the symmetric pair (I, J) (order 11, 22, 33, 12, 23, 13).
+const VOIGT: [[usize; 3]; 3] = [[0, 3, 5], [3, 1, 4], [5, 4, 2]];
+
+/// w A of one Gauss point, stored as `a[i][k][J][L]` [Pa·m³]: the first elasticity tensor
+/// A_iJkL = ∂P_iJ/∂F_kL = F_iI F_kK D_IJKL + δ_ik S_JL of the material tangent D [Pa]
+/// (Voigt, on engineering shear strains), the stress S [Pa] and the deformation gradient
+/// `f`, times the point's weight `w` [m³]. `geometric = false` leaves out δ_ik S_JL (the
+/// small-strain element, whose `f` is the identity).
 #[inline]
-fn b_matrix(f: &Mat3, g: &[f64; 3]) -> Bmat {
-    let mut b = Bmat::zeros();
-    for i in 0..3 {
-        b[(0, i)] = f[(i, 0)] * g[0];
-        b[(1, i)] = f[(i, 1)] * g[1];
-        b[(2, i)] = f[(i, 2)] * g[2];
-        b[(3, i)] = f[(i, 0)] * g[1] + f[(i, 1)] * g[0];
-        b[(4, i)] = f[(i, 1)] * g[2] + f[(i, 2)] * g[1];
-        b[(5, i)] = f[(i, 0)] * g[2] + f[(i, 2)] * g[0];
+fn weighted_first_elasticity(
+    f: &Mat3,
+    s: &Mat3,
+    d: &crate::Mat6,
+    geometric: bool,
+    w: f64,
+) -> Tensor4 {
+    let fa: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| f[(i, j)]));
+    let dd: [[f64; 6]; 6] = std::array::from_fn(|i| std::array::from_fn(|j| d[(i, j)]));
+    // y[i][J][K][L] = Σ_I F_iI D_IJKL
+    let mut y: Tensor4 = [[[[0.0; 3]; 3]; 3]; 3];
+    for (yi, fi) in y.iter_mut().zip(&fa) {
+        for (jj, yij) in yi.iter_mut().enumerate() {
+            for (kk, yijk) in yij.iter_mut().enumerate() {
+                for (ll, x) in yijk.iter_mut().enumerate() {
+                    let v = VOIGT[kk][ll];
+                    *x = fi[0] * dd[VOIGT[0][jj]][v]
+                        + fi[1] * dd[VOIGT[1][jj]][v]
+                        + fi[2] * dd[VOIGT[2][jj]][v];
+                }
+            }
+        }
     }
-    b
+    let mut a: Tensor4 = [[[[0.0; 3]; 3]; 3]; 3];
+    for (i, ai) in a.iter_mut().enumerate() {
+        for (k, aik) in ai.iter_mut().enumerate() {
+            let fk = &fa[k];
+            for (jj, aikj) in aik.iter_mut().enumerate() {
+                let yij = &y[i][jj];
+                for (ll, x) in aikj.iter_mut().enumerate() {
+                    let mut t = yij[0][ll] * fk[0] + yij[1][ll] * fk[1] + yij[2][ll] * fk[2];
+                    if geometric && i == k {
+                        t += s[(jj, ll)];
+                    }
+                    *x = w * t;
+                }
+            }
+        }
+    }
+    a
+}
+
+/// Adds the stiffness of one Gauss point, K_ab,ik += Σ_JL ∇N_aJ (wA)_iJkL ∇N_bL [N/m], to
+/// the blocks b ≥ a of `kt`, from the reference gradients `grads` [1/m] and `wa` of
+/// [`weighted_first_elasticity`]: material and geometric stiffness in one contraction,
+/// 27 products per block against the 54 of B_aᵀ (D B_b) and the geometric term apart.
+#[inline]
+fn add_point_stiffness<const N: usize>(
+    kt: &mut [[Mat3; N]; N],
+    grads: &[[f64; 3]; N],
+    wa: &Tensor4,
+) {
+    for (a, ga) in grads.iter().enumerate() {
+        // t[ik][L] = Σ_J ∇N_aJ (wA)_iJkL
+        let t: [[f64; 3]; 9] = std::array::from_fn(|ik| {
+            let aik = &wa[ik / 3][ik % 3];
+            std::array::from_fn(|ll| ga[0] * aik[0][ll] + ga[1] * aik[1][ll] + ga[2] * aik[2][ll])
+        });
+        for (kab, gb) in kt[a][a..].iter_mut().zip(&grads[a..]) {
+            let kab = kab.as_mut_slice();
+            for (ik, tik) in t.iter().enumerate() {
+                // Column-major 3×3: entry (i, k) at 3k + i.
+                kab[3 * (ik % 3) + ik / 3] += tik[0] * gb[0] + tik[1] * gb[1] + tik[2] * gb[2];
+            }
+        }
+    }
 }
 
 /// Displacement gradient H = ∂u/∂X at a Gauss point.
@@ -451,37 +514,16 @@ pub fn element_response_with_history<const N: usize, const G: usize>(
         let (w_point, s, d) = material_point(material, &c, q, viscous, with_tangent);
         energy += w_point * gp.weight;
         let w = gp.weight;
-        // Filled in place: `std::array::from_fn` copies each 6×3 block through its guard,
-        // which cost a tenth of a run's time.
-        let mut bs = [Bmat::zeros(); N];
-        for (b, g) in bs.iter_mut().zip(&gp.grad) {
-            *b = b_matrix(&fb, g);
-        }
-        let sv = nalgebra::Vector6::from(crate::material::to_voigt(&s));
-        for a in 0..N {
-            let fa = bs[a].transpose() * sv;
-            for i in 0..3 {
-                force[a][i] += w * fa[i];
+        // f_a = w P ∇N_a, P = F S the first Piola-Kirchhoff stress.
+        let p = fb * s;
+        for (fa, g) in force.iter_mut().zip(&gp.grad) {
+            for (i, x) in fa.iter_mut().enumerate() {
+                *x += w * (p[(i, 0)] * g[0] + p[(i, 1)] * g[1] + p[(i, 2)] * g[2]);
             }
         }
         if let (Some(kt), Some(d)) = (tangent.as_mut(), d) {
-            let mut dbs = [Bmat::zeros(); N];
-            for (db, b) in dbs.iter_mut().zip(&bs) {
-                *db = d * b;
-            }
-            for a in 0..N {
-                let sga = s * Vec3::from(gp.grad[a]);
-                for b in a..N {
-                    let mut kab = bs[a].transpose() * dbs[b];
-                    if !small {
-                        let geo = sga.dot(&Vec3::from(gp.grad[b]));
-                        for i in 0..3 {
-                            kab[(i, i)] += geo;
-                        }
-                    }
-                    kt[a][b] += w * kab;
-                }
-            }
+            let wa = weighted_first_elasticity(&fb, &s, &d, !small, w);
+            add_point_stiffness(kt, &gp.grad, &wa);
         }
     }
     if let Some(kt) = tangent.as_mut() {
