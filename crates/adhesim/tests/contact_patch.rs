@@ -402,8 +402,8 @@ fn shaken_hex27_block(n: usize, shake: f64, seed: u64) -> Mesh {
 /// (the mortar measure of a fully covered slave node): a triangle piece gives each of its
 /// nodes a third of its area, a quadrilateral piece ∫ φ_a dA of its bilinear hat φ_a, by the
 /// 2 × 2 Gauss rule, exact for a flat piece (φ_a and the area density both bilinear). On a
-/// parallelogram that is a quarter of its area, which is what `tributary_areas` gives every
-/// quadrilateral piece; on the quarters of a non-parallelogram face they differ.
+/// parallelogram that is a quarter of its area. Written here apart from `tributary_areas`,
+/// which must give the same (the test checks it).
 fn piece_measures(faces: &[adhesim::mesh::Face], x: &[[f64; 3]], nodes: &[usize]) -> Vec<f64> {
     use nalgebra::Vector3;
     let index: std::collections::HashMap<usize, usize> =
@@ -457,8 +457,9 @@ fn piece_measures(faces: &[adhesim::mesh::Face], x: &[[f64; 3]], nodes: &[usize]
 /// which mortar integrates the overlaps (a rule exact to degree 5), and the pressure is
 /// uniform only to that rule's error: 1.3e-6 and 1.4e-5 with the nodes moved by up to a
 /// fifth of a cell (test: 1e-4), falling with the distortion (1.6e-8 and 4.3e-7 at a
-/// twentieth; test: 1e-6, as on straight meshes). The tributary areas (a quarter of each
-/// quarter's area) are not the measure there; over them the same forces are off by 2 to 5 %.
+/// twentieth; test: 1e-6, as on straight meshes). The tributary areas are the integrals of
+/// the hats there too, equal to `piece_measures` to 5.0e-16 (test: 1e-13; a quarter of each
+/// quarter's area, as they were, put the same forces off by 1.8 and 4.8 % at a fifth).
 ///
 /// Node-to-surface on the same meshes does not pass: a site's pressure is off by more than
 /// 10 % on every mesh, matching ones included (its forces follow the quad9's consistent
@@ -501,8 +502,7 @@ fn mortar_passes_the_contact_patch_test_on_nine_node_faces() {
     }
     // Unstructured interfaces: both blocks' nodes moved within their faces. The quarters of
     // the slave faces are no longer parallelograms: a site's pressure is its force over the
-    // integral of its hat (`piece_measures`), not over its tributary area (a quarter of each
-    // quarter's area), which is printed beside it.
+    // integral of its hat (`piece_measures`), which its tributary area must equal.
     for (shake, tol) in [(0.2, 1e-4), (0.05, 1e-6)] {
         for (slave, master) in [(2, 3), (3, 2)] {
             let upper = shaken_hex27_block(slave, shake, 7);
@@ -518,12 +518,19 @@ fn mortar_passes_the_contact_patch_test_on_nine_node_faces() {
                 ContactSolver::Semismooth,
             );
             let (by_tributary_area, _) = pressure_error(&sites);
+            let area_error = sites
+                .iter()
+                .zip(&measure)
+                .map(|(s, &m)| (s.1 - m).abs() / m)
+                .fold(0.0, f64::max);
+            assert!(area_error < 1e-13, "tributary areas off by {area_error:e}");
             let sites: Vec<(f64, f64)> =
                 sites.iter().zip(&measure).map(|(s, &m)| (s.0, m)).collect();
             let (worst, lowest) = pressure_error(&sites);
             eprintln!(
             "hex27 mortar, {slave}×{slave} on {master}×{master} shaken by {shake}, Semismooth: \
-             pressure error {worst:.1e} (over the tributary areas {by_tributary_area:.1e}), \
+             pressure error {worst:.1e} (over the tributary areas {by_tributary_area:.1e}, \
+             which differ from the integrals by {area_error:.1e}), \
              lowest site force {lowest:.4} N, force {force:.10} N"
         );
             assert!((force - PRESSURE).abs() < 1e-8 * PRESSURE, "force {force}");

@@ -270,8 +270,8 @@ fn node_to_surface_between_bodies_is_refused_on_nine_node_faces() {
         .problem;
     let pair = &problem.contacts[0];
     assert!(pair.slave_faces.iter().all(|f| *f.face_type() == QUAD9));
-    // Tributary areas: a quarter of each quarter of a face to each of its four nodes; they
-    // add up to the face set's area (2.1 m²).
+    // Tributary areas: the integral of each node's bilinear hat over each quarter of a face
+    // it is a corner of; they add up to the face set's area (2.1 m²).
     let total: f64 = pair.slave_area.iter().sum();
     assert!((total - 2.1).abs() < 1e-12, "{total}");
     assert!(pair.slave_area.iter().all(|&a| a > 0.0));

@@ -174,11 +174,15 @@ pub fn flat_quads(faces: &[Face]) -> Vec<[usize; 4]> {
     out
 }
 
-/// Tributary areas of the nodes of a face set: the area of each flat piece of each face
-/// ([`Face::flat_pieces`], the face itself when it is linear) split equally among the
-/// piece's corners [m²], in the order of `nodes`. On a six-node triangle that gives a corner
-/// 1/12 of the face and a mid-side node 1/4 (the integrals of the sub-triangles' hat
-/// functions): positive, where the quadratic corner functions integrate to zero.
+/// Tributary areas of the nodes of a face set [m²], in the order of `nodes`: the integral of
+/// each node's hat function over the flat pieces of the faces ([`Face::flat_pieces`], the face
+/// itself when it is linear), [`hat_integrals`] of each piece. A triangle gives each of its
+/// corners a third of its area; a quadrilateral gives a quarter only when it is a
+/// parallelogram. On a six-node triangle that gives a corner 1/12 of the face and a mid-side
+/// node 1/4, on a flat, undistorted eight-node quadrilateral a corner 1/24 and a mid-side node
+/// 5/24, on a nine-node one a corner 1/16, a mid-side node 1/8 and the centre 1/4: positive,
+/// where the quadratic corner functions integrate to zero or less. These are the measures
+/// mortar gives a fully covered slave node, and they add up to the pieces' areas.
 pub fn tributary_areas(faces: &[Face], coords: &[[f64; 3]], nodes: &[usize]) -> Vec<f64> {
     let index: HashMap<usize, usize> = nodes.iter().enumerate().map(|(i, &n)| (n, i)).collect();
     let mut area = vec![0.0; nodes.len()];
@@ -186,10 +190,10 @@ pub fn tributary_areas(faces: &[Face], coords: &[[f64; 3]], nodes: &[usize]) -> 
         let all = f.nodes();
         for piece in f.flat_pieces() {
             let ns: Vec<usize> = piece.iter().map(|&c| all[c]).collect();
-            let a = face_area(&ns, coords);
-            for n in &ns {
+            let x: Vec<Vec3> = ns.iter().map(|&n| Vec3::from(coords[n])).collect();
+            for (n, a) in ns.iter().zip(hat_integrals(&x)) {
                 if let Some(&i) = index.get(n) {
-                    area[i] += a / ns.len() as f64;
+                    area[i] += a;
                 }
             }
         }
@@ -197,11 +201,61 @@ pub fn tributary_areas(faces: &[Face], coords: &[[f64; 3]], nodes: &[usize]) -> 
     area
 }
 
-fn face_area(ns: &[usize], x: &[[f64; 3]]) -> f64 {
-    let c = |i: usize| Vec3::from(x[ns[i]]);
-    match ns.len() {
-        3 => 0.5 * (c(1) - c(0)).cross(&(c(2) - c(0))).norm(),
-        _ => 0.5 * (c(2) - c(0)).cross(&(c(3) - c(1))).norm(),
+/// ∫ φ_a dA over a flat piece with corners `x` (a triangle, or a quadrilateral
+/// counter-clockwise) of each corner's hat function φ_a [m²], in the order of `x`.
+///
+/// A triangle's hats are its barycentric coordinates, each integrating to a third of its
+/// area, exactly.
+///
+/// A quadrilateral's hats are the bilinear functions φ_a = (1 + ξ ξ_a)(1 + η η_a)/4 of the
+/// natural coordinates (ξ, η) ∈ [−1, 1]² of its own bilinear map
+/// x(ξ, η) = Σ_a φ_a x_a = x̄ + b ξ + c η + d ξη, and ∫ φ_a dA = ∫∫ φ_a (x_ξ × x_η)·n dξ dη,
+/// n the unit normal of the cross product of its diagonals. The area vector
+/// x_ξ × x_η = b × c + ξ b × d + η d × c is linear in (ξ, η) (its ξη term is d × d = 0), so
+/// the integrand is a polynomial of degree at most 2 in ξ and in η (biquadratic), and the
+/// 2 × 2 Gauss rule, exact to degree 3 in each, integrates it exactly. The constant part
+/// (b × c)·n = A/4, A = |d₁ × d₂|/2 the area, is integrated apart (∫∫ φ_a = 1), so that a
+/// parallelogram (d = 0) gets A/4 exactly as computed before this rule; the rule integrates
+/// the rest, which vanishes there.
+///
+/// On a planar quadrilateral (x_ξ × x_η)·n is the area density, and the result is the
+/// closed form ∫ φ_a dA = (A + T_a)/6, T_a the area of the triangle of corner a and its two
+/// neighbours: A/4 only on a parallelogram (T_a = A/2). A warped quadrilateral is integrated
+/// as its projection on the plane normal to n (the plane mortar lays a face on); its four
+/// integrals add up to A, the projected area. A degenerate piece (no area) gives zeros.
+pub fn hat_integrals(x: &[Vec3]) -> Vec<f64> {
+    match x.len() {
+        3 => {
+            let area = 0.5 * (x[1] - x[0]).cross(&(x[2] - x[0])).norm();
+            vec![area / 3.0; 3]
+        }
+        4 => {
+            let twice_area = (x[2] - x[0]).cross(&(x[3] - x[1]));
+            let norm = twice_area.norm();
+            if norm == 0.0 {
+                return vec![0.0; 4];
+            }
+            let n = twice_area / norm;
+            let area = 0.5 * norm;
+            // x_ξ = b + d η, x_η = c + d ξ.
+            let b = (x[1] - x[0] + x[2] - x[3]) * 0.25;
+            let c = (x[3] - x[0] + x[2] - x[1]) * 0.25;
+            let d = (x[0] - x[1] + x[2] - x[3]) * 0.25;
+            // The area density less its constant part A/4: p ξ + q η.
+            let (p, q) = (b.cross(&d).dot(&n), d.cross(&c).dot(&n));
+            const CORNERS: [[f64; 2]; 4] = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
+            let g = 1.0 / 3f64.sqrt();
+            let mut out = vec![area / 4.0; 4];
+            // The 2 × 2 Gauss rule, weights 1.
+            for (s, t) in [(-g, -g), (g, -g), (g, g), (-g, g)] {
+                let density = p * s + q * t;
+                for (a, [sa, ta]) in CORNERS.iter().enumerate() {
+                    out[a] += 0.25 * (1.0 + sa * s) * (1.0 + ta * t) * density;
+                }
+            }
+            out
+        }
+        k => panic!("a flat piece has 3 or 4 corners, not {k}"),
     }
 }
 
@@ -628,6 +682,248 @@ mod tests {
         // A point beyond an edge projects onto the face boundary (clamped).
         let (_, _, w2) = project_on_face(&face, &pos, [-1.0, 0.5, 0.0]);
         assert!(w2[1].abs() < 1e-12 && w2[2].abs() < 1e-12);
+    }
+
+    /// Points (u, v) of a plane through (0.3, −1.2, 2.0) tilted against every axis.
+    fn tilted(uv: &[[f64; 2]]) -> Vec<Vec3> {
+        let e1 = Vec3::new(1.0, 2.0, -0.5).normalize();
+        let e2 = e1.cross(&Vec3::new(0.3, -0.4, 1.0)).normalize();
+        let o = Vec3::new(0.3, -1.2, 2.0);
+        uv.iter().map(|&[u, v]| o + e1 * u + e2 * v).collect()
+    }
+
+    /// Area of the plane polygon `uv` (counter-clockwise), by the shoelace formula.
+    fn shoelace(uv: &[[f64; 2]]) -> f64 {
+        let n = uv.len();
+        (0..n)
+            .map(|i| {
+                let (p, q) = (uv[i], uv[(i + 1) % n]);
+                0.5 * (p[0] * q[1] - q[0] * p[1])
+            })
+            .sum()
+    }
+
+    #[test]
+    fn hat_integrals_of_a_trapezoid_are_its_closed_form() {
+        // Corners (0, 0), (2, 0), (1, 1), (0, 1): area 3/2, corner triangles 1, 1, 1/2, 1/2,
+        // so ∫ φ_a dA = (A + T_a)/6 = 5/12, 5/12, 1/3, 1/3 (a quarter would be 3/8 each).
+        let a = hat_integrals(&tilted(&[[0.0, 0.0], [2.0, 0.0], [1.0, 1.0], [0.0, 1.0]]));
+        let exact = [5.0 / 12.0, 5.0 / 12.0, 1.0 / 3.0, 1.0 / 3.0];
+        let off = (0..4).map(|k| (a[k] - exact[k]).abs()).fold(0.0, f64::max);
+        eprintln!("trapezoid: {a:?}, largest error {off:.1e} m²");
+        for (got, want) in a.iter().zip(exact) {
+            assert!((got - want).abs() < 1e-15, "{a:?}");
+        }
+        // A convex quadrilateral with no parallel sides, against the closed form with its
+        // triangle areas from the shoelace formula.
+        let uv = [[0.1, -0.2], [2.1, 0.15], [1.3, 1.4], [-0.35, 0.7]];
+        let a = hat_integrals(&tilted(&uv));
+        let area = shoelace(&uv);
+        for (k, got) in a.iter().enumerate() {
+            let t = shoelace(&[uv[(k + 3) % 4], uv[k], uv[(k + 1) % 4]]);
+            let want = (area + t) / 6.0;
+            eprintln!(
+                "corner {k}: {got:.15} against (A + T_a)/6 = {want:.15} ({:.1e} of A); \
+                 a quarter would be off by {:+.2} %",
+                (got - want).abs() / area,
+                100.0 * (area / 4.0 - got) / got
+            );
+            assert!(
+                (got - want).abs() < 1e-15 * area,
+                "corner {k}: {got} against {want}"
+            );
+            // Not a quarter: these differ from A/4 by 4.8 and 7.1 % of A/4.
+            assert!((got - area / 4.0).abs() > 0.04 * area / 4.0);
+        }
+        // And against an independent quadrature: the midpoint rule on 400 × 400 cells of
+        // the natural square, with the norm of x_ξ × x_η as the area density (error
+        // O(h²) ≈ 1e-6 of the area).
+        let x = tilted(&uv);
+        let m = 400;
+        let h = 2.0 / m as f64;
+        let mut fine = [0.0; 4];
+        for i in 0..m {
+            for j in 0..m {
+                let (s, t) = (-1.0 + (i as f64 + 0.5) * h, -1.0 + (j as f64 + 0.5) * h);
+                let x_s = ((x[1] - x[0]) * (1.0 - t) + (x[2] - x[3]) * (1.0 + t)) * 0.25;
+                let x_t = ((x[3] - x[0]) * (1.0 - s) + (x[2] - x[1]) * (1.0 + s)) * 0.25;
+                let da = x_s.cross(&x_t).norm() * h * h;
+                let hat = [
+                    (1.0 - s) * (1.0 - t),
+                    (1.0 + s) * (1.0 - t),
+                    (1.0 + s) * (1.0 + t),
+                    (1.0 - s) * (1.0 + t),
+                ];
+                for k in 0..4 {
+                    fine[k] += 0.25 * hat[k] * da;
+                }
+            }
+        }
+        let off = (0..4).map(|k| (a[k] - fine[k]).abs()).fold(0.0, f64::max);
+        eprintln!(
+            "midpoint rule 400 × 400: largest difference {:.1e} of A",
+            off / area
+        );
+        for k in 0..4 {
+            assert!(
+                (a[k] - fine[k]).abs() < 1e-6 * area,
+                "{a:?} against {fine:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn hat_integrals_add_up_to_the_area() {
+        let uv = [[0.1, -0.2], [2.1, 0.15], [1.3, 1.4], [-0.35, 0.7]];
+        let sum: f64 = hat_integrals(&tilted(&uv)).iter().sum();
+        eprintln!(
+            "planar: sum − area = {:.1e} of the area",
+            (sum - shoelace(&uv)) / sum
+        );
+        assert!((sum - shoelace(&uv)).abs() < 1e-15 * sum);
+        // A warped quadrilateral (corners not in one plane): its projection on the plane of
+        // its diagonals, whose area is half the norm of their cross product.
+        let x = [
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.2, 0.1, 0.3),
+            Vec3::new(1.0, 1.1, -0.2),
+            Vec3::new(-0.1, 0.8, 0.25),
+        ];
+        let a = hat_integrals(&x);
+        let projected = 0.5 * (x[2] - x[0]).cross(&(x[3] - x[1])).norm();
+        eprintln!(
+            "warped: sum − projected area = {:.1e} m²",
+            a.iter().sum::<f64>() - projected
+        );
+        assert!((a.iter().sum::<f64>() - projected).abs() < 1e-15);
+        assert!(a.iter().all(|&v| v > 0.0));
+        // A triangle: a third of its area to each corner, exactly.
+        let t = [[0.2, 0.1], [1.9, -0.3], [0.7, 1.6]];
+        let area = shoelace(&t);
+        for v in hat_integrals(&tilted(&t)) {
+            assert!((v - area / 3.0).abs() < 1e-15 * area);
+        }
+        // No area, no share.
+        let flat = [0.0, 1.0, 2.0, 3.0].map(|u| Vec3::new(u, 2.0 * u, -u));
+        assert_eq!(hat_integrals(&flat), vec![0.0; 4]);
+    }
+
+    #[test]
+    fn hat_integrals_of_a_parallelogram_are_quarters() {
+        let uv = [[0.0, 0.0], [2.0, 0.5], [2.7, 2.1], [0.7, 1.6]];
+        let area = shoelace(&uv);
+        let a = hat_integrals(&tilted(&uv));
+        let off = a.iter().map(|v| (v - area / 4.0).abs()).fold(0.0, f64::max);
+        eprintln!(
+            "parallelogram: largest |∫ φ_a dA − A/4| = {:.1e} of A",
+            off / area
+        );
+        for v in a {
+            assert!(
+                (v - area / 4.0).abs() < 4.0 * f64::EPSILON * area,
+                "{v} against {}",
+                area / 4.0
+            );
+        }
+    }
+
+    #[test]
+    fn tributary_areas_of_quadratic_faces_are_their_pieces_hats() {
+        // A flat 2 × 3 rectangle as a six-, eight- and nine-node face, its nodes where the
+        // face types' natural coordinates put them.
+        use crate::element::{QUAD8, QUAD8_NODE_XI, QUAD9, QUAD9_NODE_XI, TRI6};
+        let on_square = |xi: &[[f64; 2]]| -> Vec<[f64; 3]> {
+            let uv: Vec<[f64; 2]> = xi
+                .iter()
+                .map(|p| [1.0 + p[0], 1.5 * (1.0 + p[1])])
+                .collect();
+            tilted(&uv).iter().map(|x| [x[0], x[1], x[2]]).collect()
+        };
+        let check = |face: Face, coords: &[[f64; 3]], area: f64, expected: &[f64]| {
+            let nodes: Vec<usize> = (0..expected.len()).collect();
+            let a = tributary_areas(&[face], coords, &nodes);
+            for (k, (got, want)) in a.iter().zip(expected).enumerate() {
+                assert!(
+                    (got - want * area).abs() < 1e-14,
+                    "node {k}: {got} against {}",
+                    want * area
+                );
+            }
+        };
+        let c8 = on_square(&QUAD8_NODE_XI);
+        let (c, m) = (1.0 / 24.0, 5.0 / 24.0);
+        check(
+            Face::new(&QUAD8, &(0..8).collect::<Vec<_>>()),
+            &c8,
+            6.0,
+            &[c, c, c, c, m, m, m, m],
+        );
+        let c9 = on_square(&QUAD9_NODE_XI);
+        let (c, m, z) = (1.0 / 16.0, 1.0 / 8.0, 1.0 / 4.0);
+        check(
+            Face::new(&QUAD9, &(0..9).collect::<Vec<_>>()),
+            &c9,
+            6.0,
+            &[c, c, c, c, m, m, m, m, z],
+        );
+        // The six-node triangle of corners (0, 0), (2, 0), (0, 3).
+        let t6 = tilted(&[
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [0.0, 3.0],
+            [1.0, 0.0],
+            [1.0, 1.5],
+            [0.0, 1.5],
+        ]);
+        let t6: Vec<[f64; 3]> = t6.iter().map(|x| [x[0], x[1], x[2]]).collect();
+        let (c, m) = (1.0 / 12.0, 1.0 / 4.0);
+        check(
+            Face::new(&TRI6, &[0, 1, 2, 3, 4, 5]),
+            &t6,
+            3.0,
+            &[c, c, c, m, m, m],
+        );
+        // A nine-node face with its nodes moved within its plane: its quarters are not
+        // parallelograms, and each node collects (A + T_a)/6 of each quarter it is a corner of.
+        let mut uv: Vec<[f64; 2]> = QUAD9_NODE_XI
+            .iter()
+            .map(|p| [1.0 + p[0], 1.5 * (1.0 + p[1])])
+            .collect();
+        let shifts = [
+            [0.1, -0.2],
+            [-0.15, 0.1],
+            [0.2, 0.05],
+            [-0.1, -0.2],
+            [0.12, 0.2],
+        ];
+        for (k, d) in [4, 5, 6, 7, 8].into_iter().zip(shifts) {
+            uv[k] = [uv[k][0] + d[0], uv[k][1] + d[1]];
+        }
+        let coords: Vec<[f64; 3]> = tilted(&uv).iter().map(|x| [x[0], x[1], x[2]]).collect();
+        let a = tributary_areas(
+            &[Face::new(&QUAD9, &(0..9).collect::<Vec<_>>())],
+            &coords,
+            &(0..9).collect::<Vec<_>>(),
+        );
+        let mut want = [0.0; 9];
+        for piece in QUAD9.flat_pieces {
+            let q: Vec<[f64; 2]> = piece.iter().map(|&k| uv[k]).collect();
+            let area = shoelace(&q);
+            for (k, &node) in piece.iter().enumerate() {
+                want[node] += (area + shoelace(&[q[(k + 3) % 4], q[k], q[(k + 1) % 4]])) / 6.0;
+            }
+        }
+        for k in 0..9 {
+            assert!(
+                (a[k] - want[k]).abs() < 1e-14,
+                "node {k}: {} against {}",
+                a[k],
+                want[k]
+            );
+        }
+        // They add up to the face's area, the octagon through its corners and mid-side nodes.
+        let outline = [uv[0], uv[4], uv[1], uv[5], uv[2], uv[6], uv[3], uv[7]];
+        assert!((a.iter().sum::<f64>() - shoelace(&outline)).abs() < 1e-14);
     }
 
     #[test]
