@@ -186,11 +186,6 @@ impl ContactSolver {
             other => other,
         }
     }
-
-    /// [`ContactSolver::for_step`] of a step with friction or adhesion.
-    pub fn for_candidates(self, candidates: usize) -> ContactSolver {
-        self.for_step(candidates, false)
-    }
 }
 
 impl Default for TimeSettings {
@@ -304,13 +299,13 @@ mod contact_solver_tests {
     #[test]
     fn auto_takes_the_solve_without_w_from_the_threshold_on() {
         let auto = ContactSolver::Auto;
-        assert_eq!(auto.for_candidates(0), ContactSolver::GaussSeidel);
+        assert_eq!(auto.for_step(0, false), ContactSolver::GaussSeidel);
         assert_eq!(
-            auto.for_candidates(AUTO_SEMISMOOTH_FROM - 1),
+            auto.for_step(AUTO_SEMISMOOTH_FROM - 1, false),
             ContactSolver::GaussSeidel
         );
         assert_eq!(
-            auto.for_candidates(AUTO_SEMISMOOTH_FROM),
+            auto.for_step(AUTO_SEMISMOOTH_FROM, false),
             ContactSolver::Semismooth
         );
         for s in [
@@ -318,8 +313,8 @@ mod contact_solver_tests {
             ContactSolver::Semismooth,
             ContactSolver::Newton,
         ] {
-            assert_eq!(s.for_candidates(10 * AUTO_SEMISMOOTH_FROM), s);
-            assert_eq!(s.for_candidates(1), s);
+            assert_eq!(s.for_step(10 * AUTO_SEMISMOOTH_FROM, false), s);
+            assert_eq!(s.for_step(1, false), s);
             assert_eq!(s.for_step(10 * AUTO_SEMISMOOTH_FROM, true), s);
         }
     }

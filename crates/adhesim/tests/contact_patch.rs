@@ -174,33 +174,47 @@ fn quadratic_patch(
     )
 }
 
+/// Moves the `nodes` of a 1 × 0.5 × 1 block of `n` × 2 × `n` cells at random by up to `shake`
+/// of a cell's size along each axis, except along the axes of the block's faces they are on
+/// (an interface node stays in the interface's plane); one draw of `seed`'s sequence per node
+/// and axis, in the order given.
+fn shake_along_faces(
+    mesh: &mut Mesh,
+    nodes: impl IntoIterator<Item = usize>,
+    n: usize,
+    shake: f64,
+    seed: u64,
+) {
+    let on = |name: &str| -> std::collections::HashSet<usize> {
+        mesh.node_sets[name].iter().copied().collect()
+    };
+    let fixed_axis = [
+        [on("left"), on("right")],
+        [on("bottom"), on("top")],
+        [on("back"), on("front")],
+    ];
+    let h = [1.0 / n as f64, 0.25, 1.0 / n as f64];
+    let mut rng = common::Rng(seed);
+    for i in nodes {
+        for k in 0..3 {
+            let shift = shake * h[k] * rng.next();
+            if !fixed_axis[k].iter().any(|s| s.contains(&i)) {
+                mesh.nodes[i][k] += shift;
+            }
+        }
+    }
+}
+
 /// The tet10 block of `n` × 2 × `n` hexahedra split, its corner nodes moved at random by up
 /// to a fifth of a hexahedron's size along the faces they are on (the interface nodes within
 /// the interface's plane) and its mid-side nodes put back at the middle of their edges: an
 /// unstructured interface, straight-sided elements.
 fn shaken_tet10_block(n: usize, seed: u64) -> Mesh {
     let mut mesh = Cells::Tet10.block([1.0, 0.5, 1.0], [n, 2, n]);
-    let on = |name: &str, mesh: &Mesh| -> std::collections::HashSet<usize> {
-        mesh.node_sets[name].iter().copied().collect()
-    };
-    let fixed_axis = [
-        [on("left", &mesh), on("right", &mesh)],
-        [on("bottom", &mesh), on("top", &mesh)],
-        [on("back", &mesh), on("front", &mesh)],
-    ];
-    let h = [1.0 / n as f64, 0.25, 1.0 / n as f64];
-    let mut rng = common::Rng(seed);
     let cells = mesh.cells_of::<10>(&adhesim::element::TET10).to_vec();
     let corners: std::collections::BTreeSet<usize> =
         cells.iter().flat_map(|c| c[..4].to_vec()).collect();
-    for &i in &corners {
-        for k in 0..3 {
-            let shift = 0.2 * h[k] * rng.next();
-            if !fixed_axis[k].iter().any(|s| s.contains(&i)) {
-                mesh.nodes[i][k] += shift;
-            }
-        }
-    }
+    shake_along_faces(&mut mesh, corners, n, 0.2, seed);
     for c in &cells {
         for (m, [i, j]) in adhesim::element::TET10_EDGES.iter().enumerate() {
             let (a, b) = (mesh.nodes[c[*i]], mesh.nodes[c[*j]]);
@@ -302,26 +316,23 @@ fn pressure_error(sites: &[(f64, f64)]) -> (f64, f64) {
     (worst, lowest)
 }
 
-#[test]
-fn mortar_passes_the_contact_patch_test_on_quadratic_faces() {
+/// The structured patch tests of the quadratic cells `cells` (named `name`, the meshes
+/// described by `meshes`) with mortar and each contact solver: the total force to 1e-8, every
+/// site's pressure to 1e-6, and no site pulls.
+fn mortar_passes_on_structured_meshes(cells: Cells, name: &str, meshes: &str) {
     for (slave, master) in [(2, 3), (3, 2), (1, 4), (3, 3)] {
         for solver in [
             ContactSolver::GaussSeidel,
             ContactSolver::Semismooth,
             ContactSolver::Newton,
         ] {
-            let (sites, force) = quadratic_patch(
-                Cells::Tet10,
-                slave,
-                master,
-                PairDiscretisation::Mortar,
-                solver,
-            );
+            let (sites, force) =
+                quadratic_patch(cells, slave, master, PairDiscretisation::Mortar, solver);
             let (worst, lowest) = pressure_error(&sites);
             eprintln!(
-                "tet10 mortar {slave}×{slave} on {master}×{master} (hexahedra split), \
-                 {solver:?}: {} sites, pressure error {worst:.1e}, lowest site force \
-                 {lowest:.4} N, force {force:.10} N",
+                "{name} mortar {slave}×{slave} on {master}×{master}{meshes}, {solver:?}: {} \
+                 sites, pressure error {worst:.1e}, lowest site force {lowest:.4} N, force \
+                 {force:.10} N",
                 sites.len()
             );
             let force_error = (force - PRESSURE).abs() / PRESSURE;
@@ -336,6 +347,11 @@ fn mortar_passes_the_contact_patch_test_on_quadratic_faces() {
             assert!(lowest > 0.0, "{slave} on {master}: a site pulls");
         }
     }
+}
+
+#[test]
+fn mortar_passes_the_contact_patch_test_on_quadratic_faces() {
+    mortar_passes_on_structured_meshes(Cells::Tet10, "tet10", " (hexahedra split)");
     // Unstructured interfaces: both blocks' nodes moved within their faces.
     for (slave, master) in [(2, 3), (3, 2)] {
         let (sites, force) = quadratic_patch_on(
@@ -375,24 +391,8 @@ fn mortar_passes_the_contact_patch_test_on_quadratic_faces() {
 /// a straight-sided cell has them: an unstructured interface of nine-node faces.
 fn shaken_hex27_block(n: usize, shake: f64, seed: u64) -> Mesh {
     let mut mesh = Cells::Hex8.block([1.0, 0.5, 1.0], [n, 2, n]);
-    let on = |name: &str, mesh: &Mesh| -> std::collections::HashSet<usize> {
-        mesh.node_sets[name].iter().copied().collect()
-    };
-    let fixed_axis = [
-        [on("left", &mesh), on("right", &mesh)],
-        [on("bottom", &mesh), on("top", &mesh)],
-        [on("back", &mesh), on("front", &mesh)],
-    ];
-    let h = [1.0 / n as f64, 0.25, 1.0 / n as f64];
-    let mut rng = common::Rng(seed);
-    for i in 0..mesh.num_nodes() {
-        for k in 0..3 {
-            let shift = shake * h[k] * rng.next();
-            if !fixed_axis[k].iter().any(|s| s.contains(&i)) {
-                mesh.nodes[i][k] += shift;
-            }
-        }
-    }
+    let all = 0..mesh.num_nodes();
+    shake_along_faces(&mut mesh, all, n, shake, seed);
     let mesh = mesh.with_mid_side_nodes().with_face_and_centre_nodes();
     assert!(adhesim::mesh::quality::inverted_cells(&mesh).is_empty());
     mesh
@@ -468,38 +468,7 @@ fn piece_measures(faces: &[adhesim::mesh::Face], x: &[[f64; 3]], nodes: &[usize]
 /// (tests/hex27.rs).
 #[test]
 fn mortar_passes_the_contact_patch_test_on_nine_node_faces() {
-    for (slave, master) in [(2, 3), (3, 2), (1, 4), (3, 3)] {
-        for solver in [
-            ContactSolver::GaussSeidel,
-            ContactSolver::Semismooth,
-            ContactSolver::Newton,
-        ] {
-            let (sites, force) = quadratic_patch(
-                Cells::Hex27,
-                slave,
-                master,
-                PairDiscretisation::Mortar,
-                solver,
-            );
-            let (worst, lowest) = pressure_error(&sites);
-            eprintln!(
-                "hex27 mortar {slave}×{slave} on {master}×{master}, {solver:?}: {} sites, \
-                 pressure error {worst:.1e}, lowest site force {lowest:.4} N, \
-                 force {force:.10} N",
-                sites.len()
-            );
-            let force_error = (force - PRESSURE).abs() / PRESSURE;
-            assert!(
-                force_error < 1e-8,
-                "{slave} on {master}, {solver:?}: force {force}"
-            );
-            assert!(
-                worst < 1e-6,
-                "{slave} on {master}, {solver:?}: pressure off by {worst:e}"
-            );
-            assert!(lowest > 0.0, "{slave} on {master}: a site pulls");
-        }
-    }
+    mortar_passes_on_structured_meshes(Cells::Hex27, "hex27", "");
     // Unstructured interfaces: both blocks' nodes moved within their faces. The quarters of
     // the slave faces are no longer parallelograms: a site's pressure is its force over the
     // integral of its hat (`piece_measures`), which its tributary area must equal.
