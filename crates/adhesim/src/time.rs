@@ -99,6 +99,12 @@ struct AttemptKind {
     method: NewtonMethod,
 }
 
+/// An attempt at a step that failed: why, and what it was (for the fall-backs).
+struct FailedAttempt {
+    reason: String,
+    kind: AttemptKind,
+}
+
 /// What one committed step did.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StepReport {
@@ -281,8 +287,6 @@ pub struct Stepper {
     delassus_cache: DelassusCache,
     /// The semismooth solve's LU analysis, kept while the mixed matrix's pattern stays.
     mixed_workspace: MixedWorkspace,
-    /// What the latest attempt was.
-    last_attempt: AttemptKind,
     /// The run's contact solver: the scenario's, until a step on which `auto` chose the
     /// augmented-Lagrangian solve fails; then `AutoWithoutNewton` for the rest of the run.
     contact_solver: ContactSolver,
@@ -343,7 +347,6 @@ impl Stepper {
             model_size: 0.0,
             delassus_cache: None,
             mixed_workspace: MixedWorkspace::default(),
-            last_attempt: AttemptKind::default(),
             reactions: vec![0.0; n],
             workspace: Workspace::default(),
         };
@@ -652,13 +655,13 @@ impl Stepper {
     fn attempt_with_fallback(&mut self, dt: f64) -> Result<Attempt, String> {
         let (method, solver) = (self.problem.time.newton, self.contact_solver);
         let mut result = self.attempt(dt, method, solver);
-        if result.is_err() && self.last_attempt.method != NewtonMethod::Full {
+        if matches!(&result, Err(f) if f.kind.method != NewtonMethod::Full) {
             result = self.attempt(dt, NewtonMethod::Full, solver);
         }
-        let Err(reason) = result else {
-            return result;
+        let (reason, last) = match result {
+            Ok(attempt) => return Ok(attempt),
+            Err(failed) => (failed.reason, failed.kind),
         };
-        let last = self.last_attempt;
         if !matches!(
             solver,
             ContactSolver::Auto | ContactSolver::AutoWithoutNewton
@@ -678,20 +681,37 @@ impl Stepper {
             // Gauss-Seidel on W before Δt is cut.
             ContactSolver::Semismooth if last.candidates <= AUTO_GAUSS_SEIDEL_RETRY_MAX => self
                 .attempt(dt, NewtonMethod::Full, ContactSolver::GaussSeidel)
-                .map_err(|again| format!("{reason}; again with Gauss-Seidel on W: {again}")),
+                .map_err(|again| {
+                    format!("{reason}; again with Gauss-Seidel on W: {}", again.reason)
+                }),
             _ => Err(reason),
         }
     }
 
-    /// One Newton solve over [t, t+dt] under `method`; Err with the reason on failure. The
-    /// stages follow docs/model.md §3: detect the contact candidates, predict, then iterate
-    /// (assemble, evaluate the contact law, check, factorise and solve, solve the contact
-    /// problem, update) until the iterate converges.
+    /// One Newton solve over [t, t+dt] under `method`; on failure the reason and what the
+    /// attempt was ([`Self::solve_attempt`]).
     fn attempt(
         &mut self,
         dt: f64,
         method: NewtonMethod,
         contact_solver: ContactSolver,
+    ) -> Result<Attempt, FailedAttempt> {
+        let mut kind = AttemptKind::default();
+        self.solve_attempt(dt, method, contact_solver, &mut kind)
+            .map_err(|reason| FailedAttempt { reason, kind })
+    }
+
+    /// The Newton solve of [`Self::attempt`], which sets `kind` once the step's contact
+    /// solver and Newton method are known; Err with the reason on failure. The stages follow
+    /// docs/model.md §3: detect the contact candidates, predict, then iterate (assemble,
+    /// evaluate the contact law, check, factorise and solve, solve the contact problem,
+    /// update) until the iterate converges.
+    fn solve_attempt(
+        &mut self,
+        dt: f64,
+        method: NewtonMethod,
+        contact_solver: ContactSolver,
+        kind: &mut AttemptKind,
     ) -> Result<Attempt, String> {
         self.disc.begin_step(dt);
         let (settings, t1) = (&self.problem.time, self.state.t + dt);
@@ -700,7 +720,7 @@ impl Stepper {
         let candidates = self.detect_contact(t1, contact_solver);
         let solver = candidates.solver;
         let method = method.for_contact(solver);
-        self.last_attempt = AttemptKind {
+        *kind = AttemptKind {
             candidates: candidates.points.len(),
             solver,
             method,
