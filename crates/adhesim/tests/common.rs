@@ -307,3 +307,39 @@ pub fn sheared_block(mesh: &Mesh, element: Formulation, nu: f64) -> Stepper {
     });
     solve(p)
 }
+
+/// Two bodies of the Gmsh mesh `mesh` (a file in tests/data), one on top of the other, in
+/// frictionless contact from the upper one's `bottom` to the lower one's `top` with the
+/// discretisation `discretisation`, parsed as a scenario file of tests/data would be.
+pub fn parse_two_boxes(
+    mesh: &str,
+    discretisation: &str,
+) -> Result<adhesim_io::scenario::Scenario, adhesim_io::scenario::ScenarioError> {
+    let text = format!(
+        r#"
+name = "boxes"
+[time]
+t_end = 1.0
+dt = 1.0
+mode = "quasi-static"
+[[body]]
+name = "lower"
+mesh = {{ file = "{mesh}" }}
+material = {{ model = "neo-hookean", young = 1e6, poisson = 0.3 }}
+density = 1000.0
+[[body]]
+name = "upper"
+mesh = {{ file = "{mesh}" }}
+material = {{ model = "neo-hookean", young = 1e6, poisson = 0.3 }}
+density = 1000.0
+[[contact]]
+name = "c"
+slave = {{ body = "upper", set = "bottom" }}
+master = {{ body = "lower", set = "top" }}
+friction = 0.0
+discretisation = "{discretisation}"
+"#
+    );
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/boxes.toml");
+    adhesim_io::scenario::parse(&text, &path)
+}

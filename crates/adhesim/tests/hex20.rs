@@ -371,40 +371,9 @@ fn gmsh_hex20_mesh_is_read_in_vtk_order() {
     }
 }
 
-/// Two bodies of the Gmsh hex20 box, one on top of the other, in contact from `top` to
-/// `bottom` with the discretisation `discretisation`.
-fn two_boxes(discretisation: &str) -> String {
-    format!(
-        r#"
-name = "boxes"
-[time]
-t_end = 1.0
-dt = 1.0
-mode = "quasi-static"
-[[body]]
-name = "lower"
-mesh = {{ file = "box_hex20.msh" }}
-material = {{ model = "neo-hookean", young = 1e6, poisson = 0.3 }}
-density = 1000.0
-[[body]]
-name = "upper"
-mesh = {{ file = "box_hex20.msh" }}
-material = {{ model = "neo-hookean", young = 1e6, poisson = 0.3 }}
-density = 1000.0
-[[contact]]
-name = "c"
-slave = {{ body = "upper", set = "bottom" }}
-master = {{ body = "lower", set = "top" }}
-friction = 0.0
-discretisation = "{discretisation}"
-"#
-    )
-}
-
 #[test]
 fn node_to_surface_between_bodies_is_refused_on_eight_node_faces() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/boxes.toml");
-    let e = adhesim_io::scenario::parse(&two_boxes("node-to-surface"), &path)
+    let e = parse_two_boxes("box_hex20.msh", "node-to-surface")
         .err()
         .expect("node-to-surface on quad8 faces is refused")
         .to_string();
@@ -412,7 +381,7 @@ fn node_to_surface_between_bodies_is_refused_on_eight_node_faces() {
         e.contains("quad8") && e.contains("hex20") && e.contains("mortar"),
         "{e}"
     );
-    let problem = adhesim_io::scenario::parse(&two_boxes("mortar"), &path)
+    let problem = parse_two_boxes("box_hex20.msh", "mortar")
         .expect("mortar on quad8 faces")
         .problem;
     let pair = &problem.contacts[0];
