@@ -71,14 +71,14 @@ impl Discretisation for Mortar {
         for face in &pair.slave_faces {
             for &piece in face.flat_pieces() {
                 let slave = SlavePiece::new(pair, face, piece, &pos, &|n| reference[n]);
-                slave.integrate(
+                let master = MasterSurface {
                     faces,
-                    &grid,
-                    &sides,
-                    &pos,
-                    pair.detection_distance,
-                    &mut integrals,
-                );
+                    grid: &grid,
+                    sides: &sides,
+                    pos: &pos,
+                    detection: pair.detection_distance,
+                };
+                slave.integrate(&master, &mut integrals);
             }
         }
         let normals = slave_normals(pair, &pos);
@@ -239,6 +239,18 @@ struct SlavePiece {
     area_ratio: f64,
 }
 
+/// The master surface a slave piece is integrated against: its `faces`, the grid that finds
+/// those near a point, which pairs of faces are integrated (`sides`), the current nodal
+/// positions `pos` [m] and the detection distance [m].
+#[derive(Clone, Copy)]
+struct MasterSurface<'a> {
+    faces: &'a [Face],
+    grid: &'a FaceGrid,
+    sides: &'a Sides,
+    pos: &'a dyn Fn(usize) -> [f64; 3],
+    detection: f64,
+}
+
 impl SlavePiece {
     /// The piece `piece` of the slave face `face` (indices into the pair's slave nodes) at
     /// the positions `pos`, with reference positions `reference`.
@@ -283,19 +295,11 @@ impl SlavePiece {
         [d.dot(&self.axes[0]), d.dot(&self.axes[1])]
     }
 
-    /// Adds this piece's segments with the master `faces` near it to the slave nodes'
+    /// Adds this piece's segments with the `master` faces near it to the slave nodes'
     /// integrals: with the dual multipliers of the piece ([`dual_coefficients`]) when the
     /// piece is a whole linear face covered by the master surface, with the piece's own
     /// weights (standard multipliers) otherwise.
-    fn integrate(
-        &self,
-        faces: &[Face],
-        grid: &FaceGrid,
-        sides: &Sides,
-        pos: &dyn Fn(usize) -> [f64; 3],
-        detection: f64,
-        integrals: &mut [NodeIntegrals],
-    ) {
+    fn integrate(&self, master: &MasterSurface<'_>, integrals: &mut [NodeIntegrals]) {
         let slave_polygon = counter_clockwise(self.corners.clone());
         let mut area = 0.0;
         for (p, w) in polygon_quadrature(&slave_polygon) {
@@ -305,27 +309,30 @@ impl SlavePiece {
             }
             area += w;
         }
-        let points = self.segment_points(faces, grid, sides, pos, detection, &slave_polygon);
+        let points = self.segment_points(master, &slave_polygon);
         let covered: f64 = points.iter().map(|q| q.w).sum();
         let dual = (self.face_type.piece_is_face(self.piece)
             && covered >= (1.0 - FULLY_COVERED) * area)
             .then(|| dual_coefficients(&points))
             .flatten();
         for q in &points {
-            self.add_point(q, faces[q.face].nodes(), dual.as_deref(), integrals);
+            self.add_point(q, master.faces[q.face].nodes(), dual.as_deref(), integrals);
         }
     }
 
     /// The quadrature points of this piece's segments with the master `faces` near it.
     fn segment_points(
         &self,
-        faces: &[Face],
-        grid: &FaceGrid,
-        sides: &Sides,
-        pos: &dyn Fn(usize) -> [f64; 3],
-        detection: f64,
+        master: &MasterSurface<'_>,
         slave_polygon: &[Point2],
     ) -> Vec<SegmentPoint> {
+        let MasterSurface {
+            faces,
+            grid,
+            sides,
+            pos,
+            detection,
+        } = *master;
         let own = key(self.nodes.iter().copied());
         let (lo, hi) = self.bounding_box(pos);
         let mut points = Vec::new();
