@@ -74,6 +74,7 @@ struct FileTime {
     contact_solver: Option<String>,
     contact_tol: Option<f64>,
     newton: Option<String>,
+    predictor: Option<String>,
 }
 
 #[derive(Deserialize, Debug)]

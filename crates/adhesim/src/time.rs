@@ -30,7 +30,9 @@ pub use crate::contact::solver::gauss_seidel::{CachedDelassus, DelassusCache};
 use crate::contact::solver::semismooth::coupling::MixedCoupling;
 use crate::contact::solver::semismooth::mixed::MixedWorkspace;
 use crate::linalg::LinalgError;
-use crate::problem::{ContactSolver, NewtonMethod, Problem, AUTO_GAUSS_SEIDEL_RETRY_MAX};
+use crate::problem::{
+    ContactSolver, NewtonMethod, Predictor, Problem, AUTO_GAUSS_SEIDEL_RETRY_MAX,
+};
 use crate::system::SystemMatrix;
 use attempt::Attempt;
 use coupling::{Candidates, ContactCoupling, StepContact};
@@ -290,6 +292,9 @@ pub struct Stepper {
     /// The run's contact solver: the scenario's, until a step on which `auto` chose the
     /// augmented-Lagrangian solve fails; then `AutoWithoutNewton` for the rest of the run.
     contact_solver: ContactSolver,
+    /// Where the attempt under way starts a quasi-static step: the scenario's predictor, or
+    /// the last state once a step has failed from it.
+    predictor: Predictor,
     /// Nodal reaction forces of the last committed step [N] (see [`Stepper::reactions`]).
     reactions: Vec<f64>,
     /// Buffers of the Newton loop.
@@ -331,6 +336,7 @@ impl Stepper {
         let mut s = Stepper {
             dt: problem.time.dt,
             contact_solver: problem.time.contact_solver,
+            predictor: problem.time.predictor,
             problem,
             disc,
             state,
@@ -648,11 +654,31 @@ impl Stepper {
             .collect()
     }
 
+    /// [`Self::attempt_with_solver_fallbacks`] from the scenario's predictor; when a
+    /// quasi-static step fails from the secant start, the same step is tried again from the
+    /// last state before the caller cuts Δt back, so that the secant start never fails a
+    /// step the last state solves (a load path with a kink, a ramp that stops, makes the
+    /// carried-on increment overshoot).
+    fn attempt_with_fallback(&mut self, dt: f64) -> Result<Attempt, String> {
+        let (quasi_static, predictor) =
+            (self.problem.time.quasi_static, self.problem.time.predictor);
+        self.predictor = predictor;
+        let first = self.attempt_with_solver_fallbacks(dt);
+        let reason = match first {
+            Err(reason) if quasi_static && predictor == Predictor::Secant => reason,
+            done => return done,
+        };
+        self.predictor = Predictor::Last;
+        let again = self.attempt_with_solver_fallbacks(dt);
+        self.predictor = predictor;
+        again.map_err(|e| format!("{reason}; again from the last state: {e}"))
+    }
+
     /// [`Self::attempt`] with the scenario's Newton method; when a modified-Newton attempt
     /// fails, the same step is tried again with full Newton (a new factorisation at every
     /// iteration) before the caller cuts Δt back, so that keeping factorisations never
     /// fails a step full Newton solves.
-    fn attempt_with_fallback(&mut self, dt: f64) -> Result<Attempt, String> {
+    fn attempt_with_solver_fallbacks(&mut self, dt: f64) -> Result<Attempt, String> {
         let (method, solver) = (self.problem.time.newton, self.contact_solver);
         let mut result = self.attempt(dt, method, solver);
         if matches!(&result, Err(f) if f.kind.method != NewtonMethod::Full) {
@@ -673,7 +699,7 @@ impl Stepper {
             // the run with the semismooth solve (and Gauss-Seidel below its threshold).
             ContactSolver::Newton => {
                 self.contact_solver = ContactSolver::AutoWithoutNewton;
-                self.attempt_with_fallback(dt).map_err(|again| {
+                self.attempt_with_solver_fallbacks(dt).map_err(|again| {
                     format!("{reason}; again without the augmented Lagrangian: {again}")
                 })
             }
@@ -745,7 +771,10 @@ impl Stepper {
         };
         let detect_time = clock.elapsed().as_secs_f64();
         let step = ThetaStep::new(
-            &Scheme::of(settings),
+            &Scheme {
+                predictor: self.predictor,
+                ..Scheme::of(settings)
+            },
             dt,
             (&self.state.u, &self.state.v),
             (&self.f_ext0, &self.f_int0),

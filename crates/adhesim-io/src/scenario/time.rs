@@ -2,7 +2,7 @@
 //! tolerance, limit and use of the factorisation), damping and the contact solver.
 
 use super::{Ctx, FileTime, ScenarioError};
-use adhesim::problem::{ContactSolver, NewtonMethod, TimeSettings};
+use adhesim::problem::{ContactSolver, NewtonMethod, Predictor, TimeSettings};
 
 /// The validated `[time]` table; keys left out take [`TimeSettings::default`]'s values.
 pub(super) fn validate_time(t: &FileTime, ctx: &Ctx) -> Result<TimeSettings, ScenarioError> {
@@ -13,6 +13,7 @@ pub(super) fn validate_time(t: &FileTime, ctx: &Ctx) -> Result<TimeSettings, Sce
     let lumped_mass = lumped_mass(t, ctx)?;
     let (newton_tol, max_newton) = newton(t, &d, ctx)?;
     let newton = newton_method(t, ctx)?;
+    let predictor = predictor(t, ctx)?;
     let rayleigh = rayleigh(t, ctx)?;
     let (contact_solver, contact_tol) = contact_solver(t, &d, ctx)?;
     Ok(TimeSettings {
@@ -29,6 +30,7 @@ pub(super) fn validate_time(t: &FileTime, ctx: &Ctx) -> Result<TimeSettings, Sce
         contact_solver,
         contact_tol,
         newton,
+        predictor,
     })
 }
 
@@ -120,6 +122,18 @@ fn newton_method(t: &FileTime, ctx: &Ctx) -> Result<NewtonMethod, ScenarioError>
         Some("preconditioned") => Ok(NewtonMethod::Preconditioned),
         Some(m) => Err(ctx.err(format!(
             "`time.newton` = {m:?}; valid values are \"auto\", \"full\", \"modified\" and \"preconditioned\""
+        ))),
+    }
+}
+
+/// Where a quasi-static step's Newton iterations start: the last increment carried on
+/// (`"secant"`, the default) or the last converged state (`"last"`).
+fn predictor(t: &FileTime, ctx: &Ctx) -> Result<Predictor, ScenarioError> {
+    match t.predictor.as_deref() {
+        None | Some("secant") => Ok(Predictor::Secant),
+        Some("last") => Ok(Predictor::Last),
+        Some(m) => Err(ctx.err(format!(
+            "`time.predictor` = {m:?}; valid values are \"secant\" and \"last\""
         ))),
     }
 }

@@ -4,6 +4,7 @@
 
 pub use crate::linalg::norm;
 use crate::linalg::BlockPattern;
+use crate::problem::Predictor;
 
 /// Mass and damping matrices, stored on the discretisation's block pattern.
 pub struct Inertia {
@@ -42,6 +43,7 @@ pub struct ThetaStep<'a> {
     theta: f64,
     xi: f64,
     quasi_static: bool,
+    predictor: Predictor,
     /// Coefficient of K in K̄ (ξ, or 1 when quasi-static).
     pub c_stiff: f64,
     /// Coefficient of M in K̄, 1/(θΔt²) (0 when quasi-static) [1/s²].
@@ -75,6 +77,8 @@ pub struct Scheme {
     pub xi: f64,
     /// Quasi-static: no inertia or damping.
     pub quasi_static: bool,
+    /// The first iterate of a quasi-static step.
+    pub predictor: Predictor,
 }
 
 impl Scheme {
@@ -84,6 +88,7 @@ impl Scheme {
             theta: settings.theta,
             xi: settings.xi,
             quasi_static: settings.quasi_static,
+            predictor: settings.predictor,
         }
     }
 }
@@ -118,6 +123,7 @@ impl<'a> ThetaStep<'a> {
             theta,
             xi,
             quasi_static: qs,
+            predictor: scheme.predictor,
             c_stiff: if qs { 1.0 } else { xi },
             c_mass: if qs { 0.0 } else { 1.0 / (theta * dt * dt) },
             c_damp: if qs { 0.0 } else { xi / (theta * dt) },
@@ -131,11 +137,13 @@ impl<'a> ThetaStep<'a> {
         }
     }
 
-    /// The first iterate: constant velocity for dynamics, the last state when quasi-static
-    /// (prescribed components still to be imposed). Sizes the workspace for the step.
+    /// The first iterate: constant velocity for dynamics; when quasi-static, the last step's
+    /// increment carried on ([`Predictor::Secant`]: v₀ is then the last step's mean rate, see
+    /// [`ThetaStep::end_velocity`]) or the last state ([`Predictor::Last`]). The prescribed
+    /// components are still to be imposed. Sizes the workspace for the step.
     pub fn predict(&self, ws: &mut Workspace) -> Vec<f64> {
         ws.resize(self.u0.len());
-        if self.quasi_static {
+        if self.quasi_static && self.predictor == Predictor::Last {
             self.u0.to_vec()
         } else {
             (0..self.u0.len())
