@@ -104,13 +104,13 @@ pub struct TimeSettings {
 /// displacements at the step's end are imposed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Predictor {
-    /// The last step's increment carried on: u₀ + Δt v₀, v₀ being the last step's mean rate
-    /// (u₀ − u₋₁)/Δt₋₁ (the first step starts from u₀). On the pad of the FEBio comparison
-    /// this saves about one Newton iteration in five (docs/scaling.md).
-    #[default]
-    Secant,
     /// The last converged state u₀.
+    #[default]
     Last,
+    /// The last step's increment carried on: u₀ + Δt v₀, v₀ being the last step's mean rate
+    /// (u₀ − u₋₁)/Δt₋₁ (the first step starts from u₀). It saves Newton iterations where the
+    /// load moves steadily and costs some where it stops or turns (docs/scenario.md).
+    Secant,
 }
 
 /// How the Newton iterations of a step use the factorisation of K̄.
@@ -219,7 +219,7 @@ impl Default for TimeSettings {
             contact_solver: ContactSolver::Auto,
             contact_tol: 1e-8,
             newton: NewtonMethod::Full,
-            predictor: Predictor::Secant,
+            predictor: Predictor::Last,
         }
     }
 }

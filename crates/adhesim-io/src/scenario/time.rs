@@ -126,14 +126,14 @@ fn newton_method(t: &FileTime, ctx: &Ctx) -> Result<NewtonMethod, ScenarioError>
     }
 }
 
-/// Where a quasi-static step's Newton iterations start: the last increment carried on
-/// (`"secant"`, the default) or the last converged state (`"last"`).
+/// Where a quasi-static step's Newton iterations start: the last converged state (`"last"`,
+/// the default) or the last increment carried on (`"secant"`).
 fn predictor(t: &FileTime, ctx: &Ctx) -> Result<Predictor, ScenarioError> {
     match t.predictor.as_deref() {
-        None | Some("secant") => Ok(Predictor::Secant),
-        Some("last") => Ok(Predictor::Last),
+        None | Some("last") => Ok(Predictor::Last),
+        Some("secant") => Ok(Predictor::Secant),
         Some(m) => Err(ctx.err(format!(
-            "`time.predictor` = {m:?}; valid values are \"secant\" and \"last\""
+            "`time.predictor` = {m:?}; valid values are \"last\" and \"secant\""
         ))),
     }
 }
