@@ -292,9 +292,6 @@ pub struct Stepper {
     /// The run's contact solver: the scenario's, until a step on which `auto` chose the
     /// augmented-Lagrangian solve fails; then `AutoWithoutNewton` for the rest of the run.
     contact_solver: ContactSolver,
-    /// Where the attempt under way starts a quasi-static step: the scenario's predictor, or
-    /// the last state once a step has failed from it.
-    predictor: Predictor,
     /// Nodal reaction forces of the last committed step [N] (see [`Stepper::reactions`]).
     reactions: Vec<f64>,
     /// Buffers of the Newton loop.
@@ -336,7 +333,6 @@ impl Stepper {
         let mut s = Stepper {
             dt: problem.time.dt,
             contact_solver: problem.time.contact_solver,
-            predictor: problem.time.predictor,
             problem,
             disc,
             state,
@@ -662,27 +658,27 @@ impl Stepper {
     fn attempt_with_fallback(&mut self, dt: f64) -> Result<Attempt, String> {
         let (quasi_static, predictor) =
             (self.problem.time.quasi_static, self.problem.time.predictor);
-        self.predictor = predictor;
-        let first = self.attempt_with_solver_fallbacks(dt);
-        let reason = match first {
+        let reason = match self.attempt_with_solver_fallbacks(dt, predictor) {
             Err(reason) if quasi_static && predictor == Predictor::Secant => reason,
             done => return done,
         };
-        self.predictor = Predictor::Last;
-        let again = self.attempt_with_solver_fallbacks(dt);
-        self.predictor = predictor;
-        again.map_err(|e| format!("{reason}; again from the last state: {e}"))
+        self.attempt_with_solver_fallbacks(dt, Predictor::Last)
+            .map_err(|e| format!("{reason}; again from the last state: {e}"))
     }
 
-    /// [`Self::attempt`] with the scenario's Newton method; when a modified-Newton attempt
-    /// fails, the same step is tried again with full Newton (a new factorisation at every
-    /// iteration) before the caller cuts Δt back, so that keeping factorisations never
-    /// fails a step full Newton solves.
-    fn attempt_with_solver_fallbacks(&mut self, dt: f64) -> Result<Attempt, String> {
+    /// [`Self::attempt`] from `predictor` with the scenario's Newton method; when a
+    /// modified-Newton attempt fails, the same step is tried again with full Newton (a new
+    /// factorisation at every iteration) before the caller cuts Δt back, so that keeping
+    /// factorisations never fails a step full Newton solves.
+    fn attempt_with_solver_fallbacks(
+        &mut self,
+        dt: f64,
+        predictor: Predictor,
+    ) -> Result<Attempt, String> {
         let (method, solver) = (self.problem.time.newton, self.contact_solver);
-        let mut result = self.attempt(dt, method, solver);
+        let mut result = self.attempt(dt, method, solver, predictor);
         if matches!(&result, Err(f) if f.kind.method != NewtonMethod::Full) {
-            result = self.attempt(dt, NewtonMethod::Full, solver);
+            result = self.attempt(dt, NewtonMethod::Full, solver, predictor);
         }
         let (reason, last) = match result {
             Ok(attempt) => return Ok(attempt),
@@ -699,14 +695,20 @@ impl Stepper {
             // the run with the semismooth solve (and Gauss-Seidel below its threshold).
             ContactSolver::Newton => {
                 self.contact_solver = ContactSolver::AutoWithoutNewton;
-                self.attempt_with_solver_fallbacks(dt).map_err(|again| {
-                    format!("{reason}; again without the augmented Lagrangian: {again}")
-                })
+                self.attempt_with_solver_fallbacks(dt, predictor)
+                    .map_err(|again| {
+                        format!("{reason}; again without the augmented Lagrangian: {again}")
+                    })
             }
             // A failed semismooth solve on few enough candidates for W: the same step with
             // Gauss-Seidel on W before Δt is cut.
             ContactSolver::Semismooth if last.candidates <= AUTO_GAUSS_SEIDEL_RETRY_MAX => self
-                .attempt(dt, NewtonMethod::Full, ContactSolver::GaussSeidel)
+                .attempt(
+                    dt,
+                    NewtonMethod::Full,
+                    ContactSolver::GaussSeidel,
+                    predictor,
+                )
                 .map_err(|again| {
                     format!("{reason}; again with Gauss-Seidel on W: {}", again.reason)
                 }),
@@ -714,16 +716,17 @@ impl Stepper {
         }
     }
 
-    /// One Newton solve over [t, t+dt] under `method`; on failure the reason and what the
-    /// attempt was ([`Self::solve_attempt`]).
+    /// One Newton solve over [t, t+dt] under `method`, a quasi-static step started from
+    /// `predictor`; on failure the reason and what the attempt was ([`Self::solve_attempt`]).
     fn attempt(
         &mut self,
         dt: f64,
         method: NewtonMethod,
         contact_solver: ContactSolver,
+        predictor: Predictor,
     ) -> Result<Attempt, FailedAttempt> {
         let mut kind = AttemptKind::default();
-        self.solve_attempt(dt, method, contact_solver, &mut kind)
+        self.solve_attempt(dt, method, contact_solver, predictor, &mut kind)
             .map_err(|reason| FailedAttempt { reason, kind })
     }
 
@@ -737,6 +740,7 @@ impl Stepper {
         dt: f64,
         method: NewtonMethod,
         contact_solver: ContactSolver,
+        predictor: Predictor,
         kind: &mut AttemptKind,
     ) -> Result<Attempt, String> {
         self.disc.begin_step(dt);
@@ -772,7 +776,7 @@ impl Stepper {
         let detect_time = clock.elapsed().as_secs_f64();
         let step = ThetaStep::new(
             &Scheme {
-                predictor: self.predictor,
+                predictor,
                 ..Scheme::of(settings)
             },
             dt,

@@ -6,7 +6,24 @@ use adhesim::material::{Hyperelastic, UncoupledNeoHookean};
 use adhesim::mesh::{generate, Mesh};
 use adhesim::problem::{Body, Dirichlet, NodalLoad, Problem, Table, TimeSettings};
 use adhesim::time::Stepper;
+use adhesim_io::scenario::{load_with, LoadOptions, Override};
+use std::path::Path;
 use std::sync::Arc;
+
+/// The scenario `file` of the repository (its path from the repository's root) with the
+/// `--set`-style overrides `sets`.
+pub fn scenario(file: &str, sets: &[&str]) -> Problem {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(file);
+    let options = LoadOptions {
+        variant: None,
+        overrides: sets.iter().map(|s| Override::parse(s).unwrap()).collect(),
+    };
+    load_with(&path, &options)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .problem
+}
 
 /// Deterministic pseudo-random numbers in [−1, 1) (xorshift), so tests are repeatable.
 pub struct Rng(pub u64);

@@ -11,20 +11,15 @@
 //! spread and fails on a step stopped short of the tolerance (a residual of 1e-6 moves the
 //! force by some 5e-5) or on another fixed point.
 
+mod common;
+
 use adhesim::problem::Problem;
 use adhesim::time::Stepper;
-use adhesim_io::scenario::{load_with, LoadOptions, Override};
-use std::path::Path;
 use std::sync::Arc;
 
 /// The pad at n = 9 with the overrides `sets`.
 fn pad(sets: &[&str]) -> Problem {
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/scale-pad.toml");
-    let options = LoadOptions {
-        variant: None,
-        overrides: sets.iter().map(|s| Override::parse(s).unwrap()).collect(),
-    };
-    load_with(&file, &options).unwrap().problem
+    common::scenario("scenarios/scale-pad.toml", sets)
 }
 
 /// What a run reports per step: the normal contact force [N], Newton iterations,

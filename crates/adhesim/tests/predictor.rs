@@ -10,23 +10,12 @@
 //! converge to, so 1e-5 holds that spread and fails on a step stopped short of the tolerance
 //! (a residual of 1e-6 moves the force by some 5e-5) or on another solution.
 
+mod common;
+
 use adhesim::problem::Problem;
 use adhesim::time::{StepReport, Stepper};
-use adhesim_io::scenario::{load_with, LoadOptions, Override};
-use std::path::Path;
+use common::scenario;
 use std::sync::Arc;
-
-/// A scenario of the repository (`file` from its root) with the overrides `sets`.
-fn scenario(file: &str, sets: &[&str]) -> Problem {
-    let file = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .join(file);
-    let options = LoadOptions {
-        variant: None,
-        overrides: sets.iter().map(|s| Override::parse(s).unwrap()).collect(),
-    };
-    load_with(&file, &options).unwrap().problem
-}
 
 /// Runs `problem` to its end: each step's report and the value `probe` reads after it.
 fn run(problem: Problem, probe: impl Fn(&Stepper) -> f64) -> Vec<(StepReport, f64)> {
@@ -74,7 +63,7 @@ fn the_secant_start_keeps_the_pads_force_in_fewer_iterations() {
 
 #[test]
 fn a_step_that_fails_from_the_secant_start_is_solved_from_the_last_state() {
-    // With 4 Newton iterations allowed, every step of the ramp converges from either start,
+    // With `max_newton = 5` (4 corrections), every step of the ramp converges from either start,
     // and the first step after the ramp does not from the secant start (it needs 5 there):
     // it is solved again from the last state, which balances the held load already.
     // The deflection: the largest vertical displacement of any node (the free end's).
